@@ -1,0 +1,29 @@
+// The subcommands of the aortasph program (SPEC.md section 1). Each returns the process exit code.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace aortasph {
+
+struct RunOptions {
+  std::filesystem::path scene;
+  std::optional<std::filesystem::path> out;  // default out/<scene name>/
+  int threads = 0;                           // 0: OpenMP's default
+  std::optional<double> end_time;
+  std::vector<std::string> sets;  // --set KEY=VALUE
+  bool no_render = false;
+  bool vtk = false;
+  bool quiet = false;
+};
+
+int cmd_run(const RunOptions& options);
+int cmd_check(const std::filesystem::path& scene, const std::vector<std::string>& sets);
+int cmd_bench(int threads, bool quick, const std::filesystem::path& json_out);
+
+// Parses the arguments after the subcommand word (throws InputError on bad arguments).
+RunOptions parse_run_options(const std::vector<std::string>& args);
+
+}  // namespace aortasph

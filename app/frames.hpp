@@ -1,0 +1,26 @@
+// Frame output of a run: snapshots of the World go to the renderer's pipeline (render thread, bounded queue),
+// which writes frames/<camera>/frame_NNNNN.png and, at the end, figures/<name>.png.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+
+#include "world.hpp"
+
+namespace aortasph {
+
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+  // Called at every output time by the simulation thread; blocks only while the queue is full.
+  virtual void push(const World& world, int frame) = 0;
+  // Drains the queue and writes the figure sheets; throws on a render or write error.
+  virtual void finish() = 0;
+  // Same, after a failed run: writes what it can, never throws.
+  virtual void finish_quietly() = 0;
+};
+
+// nullptr when the scene has no camera.
+std::unique_ptr<FrameSink> make_frame_sink(const Scene& scene, const std::filesystem::path& out_dir);
+
+}  // namespace aortasph

@@ -1,0 +1,114 @@
+// aortasph: the command line (SPEC.md section 1). Dispatches to the subcommands and maps errors to exit codes:
+// 2 bad input, 3 unstable simulation, 1 images differ (compare), 130 interrupted.
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "errors.hpp"
+#include "sim_errors.hpp"
+#include "render_commands.hpp"
+
+namespace {
+
+const char* kUsage =
+    "aortasph " AORTASPH_VERSION
+    " - fluid, elastic and rigid bodies in one SPH framework, rendered offscreen\n"
+    "\n"
+    "usage:\n"
+    "  aortasph run SCENE.json [--out DIR] [--threads N] [--end-time T] [--set KEY=VALUE]...\n"
+    "                          [--no-render] [--vtk] [--quiet]\n"
+    "  aortasph check SCENE.json [--set KEY=VALUE]...   validate and print bodies, counts, h, dt, cost\n"
+    "  aortasph compare A B [--diff DIFF.png] [--tolerance T]\n"
+    "  aortasph movie DIR [--fps N]\n"
+    "  aortasph bench [--threads N] [--quick] [--json FILE]\n"
+    "  aortasph --help | --version\n"
+    "\n"
+    "exit codes: 0 ok, 1 compare: images differ, 2 bad input, 3 unstable simulation, 130 interrupted\n";
+
+int dispatch(const std::vector<std::string>& args) {
+  using namespace aortasph;
+  if (args.empty()) {
+    std::fputs(kUsage, stderr);
+    return 2;
+  }
+  const std::string& cmd = args[0];
+  const std::vector<std::string> rest(args.begin() + 1, args.end());
+  if (cmd == "--help" || cmd == "-h" || cmd == "help") {
+    std::fputs(kUsage, stdout);
+    return 0;
+  }
+  if (cmd == "--version") {
+    std::printf("aortasph %s\n", AORTASPH_VERSION);
+    return 0;
+  }
+  if (cmd == "run") return cmd_run(parse_run_options(rest));
+  if (cmd == "check") {
+    std::string scene;
+    std::vector<std::string> sets;
+    for (std::size_t k = 0; k < rest.size(); ++k) {
+      if (rest[k] == "--set") {
+        if (k + 1 >= rest.size()) throw InputError("--set: missing value");
+        sets.push_back(rest[++k]);
+      } else if (!rest[k].empty() && rest[k][0] == '-') {
+        throw InputError(rest[k] + ": unknown option for check");
+      } else if (scene.empty()) {
+        scene = rest[k];
+      } else {
+        throw InputError(rest[k] + ": unexpected argument");
+      }
+    }
+    if (scene.empty()) throw InputError("check: missing the scene file");
+    return cmd_check(scene, sets);
+  }
+  if (cmd == "bench") {
+    int threads = 0;
+    bool quick = false;
+    std::string json = "bench.json";
+    for (std::size_t k = 0; k < rest.size(); ++k) {
+      if (rest[k] == "--quick") {
+        quick = true;
+      } else if (rest[k] == "--threads" && k + 1 < rest.size()) {
+        try {
+          threads = std::stoi(rest[++k]);
+        } catch (const std::exception&) {
+          threads = 0;
+        }
+        if (threads < 1) throw InputError("--threads: expected a positive integer, got " + rest[k]);
+      } else if (rest[k] == "--json" && k + 1 < rest.size()) {
+        json = rest[++k];
+      } else {
+        throw InputError(rest[k] + ": unknown option for bench");
+      }
+    }
+    return cmd_bench(threads, quick, json);
+  }
+  if (cmd == "compare") return cmd_compare(rest);
+  if (cmd == "movie") return cmd_movie(rest);
+  throw InputError(cmd + ": unknown command (see aortasph --help)");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::vector<std::string> args(argv + 1, argv + argc);
+  try {
+    return dispatch(args);
+  } catch (const aortasph::InputError& e) {
+    std::fprintf(stderr, "aortasph: error: %s\n", e.what());
+    return 2;
+  } catch (const aortasph::SetupError& e) {
+    std::fprintf(stderr, "aortasph: error: %s\n", e.what());
+    return 2;
+  } catch (const aortasph::InstabilityError& e) {
+    std::fprintf(stderr, "aortasph: %s\n", e.what());
+    return 3;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "aortasph: error: out of memory (reduce the resolution or the domain)\n");
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "aortasph: internal error: %s\n", e.what());
+    return 1;
+  }
+}

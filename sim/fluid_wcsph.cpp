@@ -1,0 +1,120 @@
+#include "fluid_wcsph.hpp"
+
+#include "parallel.hpp"
+
+namespace aortasph {
+
+void fluid_density_summation(Particles& P, const NeighborSearch& nb, const FluidContext& ctx) {
+  const auto& idx = nb.index();
+  const double w0 = ctx.kernel.W(0.0);
+  parallel_for(P.size(), [&](std::size_t i) {
+    if (P.kind[i] != Kind::Fluid || !ctx.params[P.material[i]].summation) return;
+    // eq. (11): rho_i = sum_j m_j W_ij, self term included. Boundary particles carry the mass of the fluid
+    // they stand in for, which keeps the sum complete next to walls.
+    double rho = P.m[i] * w0;
+    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
+      const uint32_t j = idx[k];
+      rho += P.m[j] * ctx.kernel.W((P.x[i] - P.x[j]).norm());
+    }
+    P.rho[i] = rho;
+  });
+}
+
+void fluid_pressure(Particles& P, const FluidContext& ctx) {
+  parallel_for(P.size(), [&](std::size_t i) {
+    if (P.kind[i] == Kind::Fluid) P.p[i] = ctx.params[P.material[i]].pressure(P.rho[i]);
+  });
+}
+
+void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidContext& ctx) {
+  const auto& idx = nb.index();
+  const CubicSpline& K = ctx.kernel;
+  const double h = K.h;
+  parallel_for_dynamic(P.size(), [&](std::size_t i) {
+    if (P.kind[i] != Kind::Fluid) return;
+    const FluidParams& fi = ctx.params[P.material[i]];
+    if (fi.summation) return;
+    const Vec3 xi = P.x[i];
+    const Vec3 vi = P.v[i];
+    const double rhoi = P.rho[i];
+    const double diffusion = 2.0 * fi.delta * h * fi.c0;
+    const double inv_c2 = 1.0 / (fi.c0 * fi.c0);
+    double drho = 0.0;
+    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
+      const uint32_t j = idx[k];
+      const Vec3 xij = xi - P.x[j];
+      const double r = xij.norm();
+      if (r <= 0.0) continue;
+      const double dwdr_r = K.dWdr(r) / r;
+      // Continuity, eq. (12) with x_ij = x_i - x_j, v_ij = v_i - v_j (the paper's minus sign belongs to
+      // v_ji): approaching particles compress. A boundary particle contributes with its own velocity: this is
+      // where a moving wall's velocity enters the fluid's density (Adami et al. 2012).
+      drho += P.m[j] * dwdr_r * (vi - P.v[j]).dot(xij);
+      // Density diffusion (Molteni & Colagrossi 2009, eq. 12) between particles of one fluid, minus the
+      // hydrostatic density difference rho0 g.x_ji / c0^2 (Fourtakas et al. 2019, eq. 19, linearised Tait).
+      if (diffusion > 0.0 && P.kind[j] == Kind::Fluid && P.material[j] == P.material[i]) {
+        const double hydro = fi.rho0 * ctx.gravity.dot(P.x[j] - xi) * inv_c2;
+        drho -= diffusion * (P.rho[j] - rhoi - hydro) * dwdr_r * (P.m[j] / P.rho[j]);
+      }
+    }
+    P.drho[i] = drho;
+  });
+}
+
+void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ctx) {
+  const auto& idx = nb.index();
+  const CubicSpline& K = ctx.kernel;
+  const double h = K.h;
+  const double eta2 = 0.01 * h * h;  // the 0.01 h^2 of eq. (10): keeps the sum finite as r -> 0
+
+  parallel_for_dynamic(P.size(), [&](std::size_t i) {
+    if (P.kind[i] != Kind::Fluid) return;
+    const FluidParams& fi = ctx.params[P.material[i]];
+    const Vec3 xi = P.x[i];
+    const Vec3 vi = P.v[i];
+    const double rhoi = P.rho[i];
+    const double pi_term = P.p[i] / (rhoi * rhoi);
+
+    Vec3 acc = Vec3::Zero();
+    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
+      const uint32_t j = idx[k];
+      const Vec3 xij = xi - P.x[j];
+      const double r = xij.norm();
+      const double dwdr = K.dWdr(r);
+      const Vec3 gradW = (r > 0.0 ? dwdr / r : 0.0) * xij;  // grad_i W_ij
+      const double mj = P.m[j];
+      const double rhoj = P.rho[j];
+      const bool fluid_j = P.kind[j] == Kind::Fluid;
+      const Vec3 vij = vi - P.v[j];
+
+      // Pressure, eq. (9) with the 1/rho_i of Algorithm 1 line 9 applied: a_i = -sum m_j (p_i/rho_i^2 +
+      // p_j/rho_j^2) grad W. The factor is symmetric in i and j, so pair forces cancel exactly.
+      double scalar = -(pi_term + P.p[j] / (rhoj * rhoj));
+
+      // Artificial viscosity (Monaghan 1992): only for approaching pairs.
+      if (fi.alpha > 0.0) {
+        const double vx = vij.dot(xij);
+        if (vx < 0.0) {
+          const double cbar = fluid_j ? 0.5 * (fi.c0 + ctx.params[P.material[j]].c0) : fi.c0;
+          const double mu = h * vx / (r * r + eta2);
+          scalar += fi.alpha * cbar * mu / (0.5 * (rhoi + rhoj));  // -Pi_ij, Pi_ij = -alpha c mu / rho
+        }
+      }
+      acc += (mj * scalar) * gradW;
+
+      // Viscosity, eq. (10), in the form symmetric in i and j (Morris, Fox & Zhu 1997, eq. 8): 2/rho_j becomes
+      // 1/rho_i + 1/rho_j, equal to eq. (10) at uniform density and exactly momentum conserving. Boundary
+      // particles use their extrapolated no-slip velocity (Adami et al. 2012, eq. 22): the wall's own velocity
+      // enters the viscous force here.
+      const double nu = fluid_j ? 0.5 * (fi.nu + ctx.params[P.material[j]].nu) : fi.nu;
+      if (nu > 0.0) {
+        const Vec3 vij_visc = fluid_j ? vij : Vec3(vi - P.v_wall[j]);
+        const double f = nu * mj * (1.0 / rhoi + 1.0 / rhoj) * (r * dwdr) / (r * r + eta2);
+        acc += f * vij_visc;
+      }
+    }
+    P.a[i] = acc + ctx.gravity;
+  });
+}
+
+}  // namespace aortasph

@@ -1,0 +1,73 @@
+// Weakly compressible SPH fluid, paper section 3.1 and Algorithm 1:
+//   density by the continuity equation (eq. 12) or by summation (eq. 11), Tait equation of state (eq. 13),
+//   pressure gradient in the symmetric form (eq. 9), Laplacian viscosity (eq. 10), gravity.
+// Stabilisers, each switchable per material in the scene:
+//   - density diffusion ("delta-SPH"): Molteni & Colagrossi 2009, Comput. Phys. Commun. 180:861, with the
+//     hydrostatic correction of Fourtakas et al. 2019, Comput. Fluids 190:346 (so a fluid at rest stays at rest);
+//   - artificial viscosity: Monaghan 1992, Annu. Rev. Astron. Astrophys. 30:543, eq. (4.2).
+// Boundary particles (walls, later rigid and elastic bodies) enter the sums through the values the wall
+// boundary (boundary.hpp) gives them: pressure, density and a no-slip velocity.
+#pragma once
+
+#include <cmath>
+
+#include "kernel.hpp"
+#include "neighbors.hpp"
+#include "particles.hpp"
+
+namespace aortasph {
+
+// Per-material constants derived once from the scene (read-only during a run).
+struct FluidParams {
+  double rho0 = 1000.0;
+  double c0 = 20.0;
+  double gamma = 7.0;
+  double B = 0.0;  // Tait stiffness k = rho0 c0^2 / gamma, eq. (13)
+  double nu = 0.0;
+  double delta = 0.0;
+  double alpha = 0.0;
+  double p_background = 0.0;
+  bool summation = false;
+
+  explicit FluidParams(const Material& m)
+      : rho0(m.density),
+        c0(m.sound_speed),
+        gamma(m.eos_exponent),
+        B(m.density * m.sound_speed * m.sound_speed / m.eos_exponent),
+        nu(m.viscosity),
+        delta(m.delta_sph),
+        alpha(m.artificial_viscosity),
+        p_background(m.background_pressure),
+        summation(m.density_summation) {}
+  FluidParams() = default;
+
+  // Tait equation, eq. (13): p = k ((rho / rho0)^gamma - 1).
+  double pressure(double rho) const {
+    return B * (std::pow(rho / rho0, gamma) - 1.0) + p_background;
+  }
+  // Its inverse, for boundary particles that receive a pressure.
+  double density(double p) const {
+    return rho0 * std::pow(std::max((p - p_background) / B + 1.0, 1e-6), 1.0 / gamma);
+  }
+};
+
+struct FluidContext {
+  const CubicSpline& kernel;
+  const std::vector<FluidParams>& params;  // indexed by material; only fluid entries are valid
+  Vec3 gravity;
+};
+
+// Density by summation, eq. (11), for fluid particles whose material asks for it.
+void fluid_density_summation(Particles& P, const NeighborSearch& nb, const FluidContext& ctx);
+
+// Pressure from density, eq. (13), for every fluid particle.
+void fluid_pressure(Particles& P, const FluidContext& ctx);
+
+// d rho / dt of every fluid particle by continuity (eq. 12) plus density diffusion.
+void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidContext& ctx);
+
+// Acceleration of every fluid particle: pressure (eq. 9), viscosity (eq. 10), artificial viscosity, gravity.
+// Gathers: each fluid particle writes only its own a.
+void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ctx);
+
+}  // namespace aortasph

@@ -1,0 +1,136 @@
+#include "neighbors.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "parallel.hpp"
+
+namespace aortasph {
+
+namespace {
+
+// Spread the lower 10 bits of v to every third bit (for a 30-bit Morton code).
+uint64_t spread_bits(uint64_t v) {
+  v &= 0x3ff;
+  v = (v | (v << 16)) & 0x30000ff;
+  v = (v | (v << 8)) & 0x300f00f;
+  v = (v | (v << 4)) & 0x30c30c3;
+  v = (v | (v << 2)) & 0x9249249;
+  return v;
+}
+
+struct BoundsAcc {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::max());
+  Vec3 hi = Vec3::Constant(std::numeric_limits<double>::lowest());
+};
+
+}  // namespace
+
+void NeighborSearch::build(const std::vector<Vec3>& x, double radius) {
+  const std::size_t n = x.size();
+  offset_.assign(n + 1, 0);
+  index_.clear();
+  cell_of_.resize(n);
+  if (n == 0) return;
+
+  // Grid over the particles' bounding box. The cell count is capped at a few per particle so that a
+  // sparse scene (two bodies far apart) cannot exhaust memory; bigger cells stay correct, only slower.
+  const BoundsAcc box = parallel_reduce(
+      n, BoundsAcc{}, [&](std::size_t i) { return BoundsAcc{x[i], x[i]}; },
+      [](const BoundsAcc& a, const BoundsAcc& b) {
+        return BoundsAcc{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)};
+      });
+  cell_ = radius;
+  const double max_cells = 8.0 * static_cast<double>(n) + 1024.0;
+  for (;;) {
+    double total = 1.0;
+    for (int d = 0; d < 3; ++d) {
+      dims_[d] = static_cast<int>(std::floor((box.hi[d] - box.lo[d]) / cell_)) + 1;
+      total *= dims_[d];
+    }
+    if (total <= max_cells) break;
+    cell_ *= 1.5;
+  }
+  origin_ = box.lo;
+  const std::size_t ncell = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
+
+  auto cell_coord = [&](const Vec3& p, int d) {
+    const int c = static_cast<int>((p[d] - origin_[d]) / cell_);
+    return std::clamp(c, 0, dims_[d] - 1);
+  };
+  parallel_for(n, [&](std::size_t i) {
+    const int cx = cell_coord(x[i], 0), cy = cell_coord(x[i], 1), cz = cell_coord(x[i], 2);
+    cell_of_[i] = static_cast<uint32_t>((static_cast<std::size_t>(cz) * dims_[1] + cy) * dims_[0] + cx);
+  });
+
+  // Counting sort of particles into cells: stable, so each cell lists its particles by index.
+  cell_start_.assign(ncell + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) ++cell_start_[cell_of_[i] + 1];
+  for (std::size_t c = 0; c < ncell; ++c) cell_start_[c + 1] += cell_start_[c];
+  cell_items_.resize(n);
+  {
+    std::vector<uint32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) cell_items_[fill[cell_of_[i]]++] = static_cast<uint32_t>(i);
+  }
+
+  const double r2 = radius * radius;
+  // Visit the candidates of i in a fixed order; call found(j) for each neighbour.
+  auto visit = [&](std::size_t i, auto&& found) {
+    const uint32_t c = cell_of_[i];
+    const int cx = static_cast<int>(c % dims_[0]);
+    const int cy = static_cast<int>((c / dims_[0]) % dims_[1]);
+    const int cz = static_cast<int>(c / (static_cast<std::size_t>(dims_[0]) * dims_[1]));
+    const Vec3 xi = x[i];
+    for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, dims_[2] - 1); ++z)
+      for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, dims_[1] - 1); ++y) {
+        const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
+        const uint32_t b = cell_start_[row + std::max(cx - 1, 0)];
+        const uint32_t e = cell_start_[row + std::min(cx + 1, dims_[0] - 1) + 1];
+        // Cells x-1, x, x+1 of one row are contiguous in cell_items_.
+        for (uint32_t k = b; k < e; ++k) {
+          const uint32_t j = cell_items_[k];
+          if (j == i) continue;
+          if ((x[j] - xi).squaredNorm() < r2) found(j);
+        }
+      }
+  };
+
+  // Two passes, count then fill, so that the list is written without locks or per-thread buffers.
+  parallel_for_dynamic(n, [&](std::size_t i) {
+    uint32_t count = 0;
+    visit(i, [&](uint32_t) { ++count; });
+    offset_[i + 1] = count;
+  });
+  for (std::size_t i = 0; i < n; ++i) offset_[i + 1] += offset_[i];
+  index_.resize(offset_[n]);
+  parallel_for_dynamic(n, [&](std::size_t i) {
+    uint32_t k = offset_[i];
+    visit(i, [&](uint32_t j) { index_[k++] = j; });
+  });
+}
+
+std::size_t NeighborSearch::bytes() const {
+  return (offset_.capacity() + index_.capacity() + cell_of_.capacity() + cell_start_.capacity() +
+          cell_items_.capacity()) *
+         sizeof(uint32_t);
+}
+
+std::vector<uint32_t> NeighborSearch::spatial_order() const {
+  const std::size_t n = cell_of_.size();
+  std::vector<uint64_t> key(n);
+  parallel_for(n, [&](std::size_t i) {
+    const uint32_t c = cell_of_[i];
+    const uint64_t cx = c % dims_[0];
+    const uint64_t cy = (c / dims_[0]) % dims_[1];
+    const uint64_t cz = c / (static_cast<uint64_t>(dims_[0]) * dims_[1]);
+    const uint64_t morton = spread_bits(cx) | (spread_bits(cy) << 1) | (spread_bits(cz) << 2);
+    key[i] = (morton << 32) | i;  // ties broken by index: a total, deterministic order
+  });
+  std::sort(key.begin(), key.end());
+  std::vector<uint32_t> order(n);
+  for (std::size_t k = 0; k < n; ++k) order[k] = static_cast<uint32_t>(key[k] & 0xffffffffu);
+  return order;
+}
+
+}  // namespace aortasph

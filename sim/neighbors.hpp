@@ -1,0 +1,43 @@
+// Cell-linked-list neighbour search (Monaghan & Lattanzio 1985; the "linked list" of Hockney & Eastwood),
+// O(N): particles are binned into cubic cells of edge = kernel support, and the candidates of particle i are
+// the particles of the 27 cells around its own. The result is a compressed row list (CSR): the neighbours of
+// i are index[offset[i] .. offset[i+1]), in a fixed order (cells in z, y, x order, then particle index), so
+// every sum over neighbours is bitwise the same for any thread count.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "scene.hpp"
+
+namespace aortasph {
+
+class NeighborSearch {
+ public:
+  // All pairs i != j with |x_i - x_j| < radius.
+  void build(const std::vector<Vec3>& x, double radius);
+
+  std::size_t size() const { return offset_.empty() ? 0 : offset_.size() - 1; }
+  uint32_t begin(std::size_t i) const { return offset_[i]; }
+  uint32_t end(std::size_t i) const { return offset_[i + 1]; }
+  const std::vector<uint32_t>& index() const { return index_; }
+  std::size_t pairs() const { return index_.size(); }
+  std::size_t bytes() const;
+
+  // A permutation that puts particles of nearby cells next to each other in memory (Morton / Z-order of
+  // the cells, then current index). Valid after build().
+  std::vector<uint32_t> spatial_order() const;
+
+ private:
+  std::vector<uint32_t> offset_;
+  std::vector<uint32_t> index_;
+  // Cell grid of the last build.
+  Vec3 origin_ = Vec3::Zero();
+  double cell_ = 1.0;
+  int dims_[3] = {1, 1, 1};
+  std::vector<uint32_t> cell_of_;     // cell index of each particle
+  std::vector<uint32_t> cell_start_;  // CSR over cells
+  std::vector<uint32_t> cell_items_;
+};
+
+}  // namespace aortasph

@@ -1,0 +1,28 @@
+// Probes: measured values written as one row of probes.csv per output time (SPEC.md section 3).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "world.hpp"
+
+namespace aortasph {
+
+class ProbeSet {
+ public:
+  // Resolves what needs the initial state (the particle a `point` probe follows). Throws SetupError for a
+  // probe the world cannot measure.
+  ProbeSet(const Scene& scene, const World& world);
+
+  // Column names, without the leading `time`.
+  const std::vector<std::string>& columns() const { return columns_; }
+  // One value per column; NaN where a probe has nothing to measure (an extent over no particle).
+  std::vector<double> measure(const World& world) const;
+
+ private:
+  std::vector<Probe> probes_;
+  std::vector<uint32_t> tracked_id_;  // per probe: particle id followed by a `point` probe
+  std::vector<std::string> columns_;
+};
+
+}  // namespace aortasph

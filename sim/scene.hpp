@@ -1,0 +1,151 @@
+// Scene description: plain, validated values (SPEC.md section 2). No JSON here: app/scene_loader parses
+// and validates the JSON file into these structs; sim/ builds a World from them; render/ reads RenderSettings.
+#pragma once
+
+#include <Eigen/Dense>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace aortasph {
+
+using Vec3 = Eigen::Vector3d;
+
+struct Box {
+  Vec3 min = Vec3::Zero();
+  Vec3 max = Vec3::Zero();
+  bool contains(const Vec3& p) const {
+    return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
+  }
+};
+
+enum class MaterialType { Fluid, Elastic, Rigid, Wall };
+
+struct Material {
+  std::string name;
+  MaterialType type = MaterialType::Fluid;
+  double density = 1000.0;  // rest density rho0 [kg/m^3] (unused for walls)
+
+  // Fluid (weakly compressible SPH, paper section 3.1)
+  double viscosity = 1e-6;      // kinematic viscosity nu [m^2/s], paper eq. (10)
+  double sound_speed = 20.0;    // numerical sound speed c0 [m/s]; Tait k = rho0 c0^2 / gamma
+  double eos_exponent = 7.0;    // gamma in the Tait equation, paper eq. (13)
+  double delta_sph = 0.1;       // density diffusion delta (Antuono et al. 2010); 0 switches it off
+  double artificial_viscosity = 0.0;  // Monaghan alpha (Monaghan 1992); 0 switches it off
+  bool density_summation = false;     // eq. (11) instead of the continuity equation (12)
+  double background_pressure = 0.0;   // added to the Tait pressure [Pa]
+
+  // Elastic (Total-Lagrangian SPH, paper section 3.2)
+  double youngs_modulus = 0.0;
+  double poisson_ratio = 0.0;
+  double hourglass = 10.0;          // Ganzenmueller 2015 hourglass coefficient
+  double solid_art_viscosity = 1.0; // artificial viscosity alpha for solids
+};
+
+enum class ShapeKind { Box, Sphere, Cylinder, Container, Tube, AorticRoot, Mesh };
+
+struct Shape {
+  ShapeKind kind = ShapeKind::Box;
+  Box box;                      // box, container (inner box)
+  Vec3 center = Vec3::Zero();   // sphere
+  double radius = 0.0;          // sphere, cylinder, tube (inner radius)
+  Vec3 base = Vec3::Zero();     // cylinder, tube: centre of the base disc
+  Vec3 axis = Vec3::UnitY();    // cylinder, tube: unit axis
+  double length = 0.0;          // cylinder, tube
+  int layers = 3;               // container, tube: particle layers outside the surface
+  std::vector<std::string> open;  // container: faces left out, "+x","-x","+y","-y","+z","-z"; tube: "+", "-" ends capped unless open (tube ends are open by default)
+  std::string mesh_file;        // mesh
+};
+
+enum class RenderMode { Particles, Surface, Hidden };
+
+struct Body {
+  std::string name;
+  int material = 0;  // index into Scene::materials
+  Shape shape;
+  Vec3 translate = Vec3::Zero();
+  Vec3 rotate_axis = Vec3::UnitY();
+  double rotate_degrees = 0.0;
+  Vec3 velocity = Vec3::Zero();
+  Vec3 angular_velocity = Vec3::Zero();
+  std::optional<Vec3> color;  // rgb in 0..1
+  RenderMode render = RenderMode::Particles;
+  std::optional<Box> fixed;   // elastic bodies: particles inside are clamped
+};
+
+struct Contact {
+  double stiffness = 0.0;  // k, paper eq. (23) [N/m]
+  double damping = 0.0;    // eta, eq. (24) [N s/m]
+  double shear = 0.0;      // eq. (25) [N s/m]
+  double friction = 0.5;   // Coulomb bound on the shear force
+};
+
+enum class ProbeType { Extent, Pressure, BodyState, Point, Energy, Momentum, FlowRate, OrificeArea };
+
+struct Probe {
+  std::string name;
+  ProbeType type = ProbeType::Extent;
+  std::vector<int> bodies;  // extent: indices into Scene::bodies
+  int body = -1;            // body, point, orifice_area
+  int axis = 0;             // extent: 0,1,2 = x,y,z
+  bool stat_max = true;     // extent: max or min
+  std::optional<Box> region;
+  Vec3 point = Vec3::Zero();      // pressure, flow_rate, orifice_area
+  Vec3 normal = Vec3::UnitY();    // flow_rate, orifice_area
+  Vec3 reference = Vec3::Zero();  // point
+  double radius = 0.0;            // flow_rate
+};
+
+struct Camera {
+  std::string name;
+  Vec3 eye = Vec3(0, 0, 1);
+  Vec3 target = Vec3::Zero();
+  Vec3 up = Vec3::UnitY();
+  double fov_deg = 35.0;
+};
+
+struct Figure {
+  std::string name;
+  std::string camera;
+  std::vector<double> times;
+  int columns = 3;
+};
+
+struct Clip {
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::UnitZ();
+  std::vector<int> bodies;  // bodies cut by the plane (the half on the +normal side is removed)
+};
+
+struct RenderSettings {
+  int width = 1280;
+  int height = 720;
+  Vec3 background = Vec3(1, 1, 1);
+  std::string color_by = "material";  // material, speed, pressure, displacement, stress
+  std::string colormap = "viridis";
+  std::optional<std::pair<double, double>> range;
+  std::vector<Camera> cameras;
+  std::optional<Clip> clip;
+  std::vector<Figure> figures;
+};
+
+struct Scene {
+  std::string name;
+  Box domain;
+  double max_leave_fraction = 0.0;
+  double spacing = 0.01;
+  double smoothing_ratio = 1.3;  // h = smoothing_ratio * spacing
+  double t_end = 1.0;
+  double output_interval = 0.01;
+  double cfl = 0.25;
+  double max_dt = 1e-3;
+  double max_speed = 0.0;  // instability limit [m/s]; 0 = derived from the sound speed
+  Vec3 gravity = Vec3(0, -9.81, 0);
+  std::vector<Material> materials;
+  Contact contact;
+  std::vector<Body> bodies;
+  std::vector<Probe> probes;
+  RenderSettings render;
+};
+
+}  // namespace aortasph

@@ -1,0 +1,42 @@
+// Snapshot: a copy of what the renderer needs at one output time. The simulation fills it and hands it to the
+// render thread (render/pipeline), so the renderer never touches live simulation state.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "scene.hpp"
+
+namespace aortasph {
+
+// Triangle mesh in single precision, used for wall surfaces (render: "surface").
+struct SurfaceMesh {
+  std::vector<std::array<float, 3>> vertices;
+  std::vector<std::array<uint32_t, 3>> triangles;  // counter-clockwise seen from outside (normal points out)
+  bool empty() const { return triangles.empty(); }
+};
+
+struct BodyView {
+  std::string name;
+  MaterialType type = MaterialType::Fluid;
+  std::array<float, 3> color = {0.2f, 0.4f, 0.9f};  // rgb 0..1, from the scene or a default per material
+  RenderMode render = RenderMode::Particles;
+  SurfaceMesh mesh;  // in world coordinates at this snapshot's time (may be empty)
+};
+
+struct Snapshot {
+  double time = 0.0;
+  int frame = 0;            // output index k: time = k * output_interval
+  double spacing = 0.01;    // particle spacing: splat radius = spacing / 2
+  std::vector<float> position;   // 3 * n, xyz per particle
+  std::vector<uint16_t> body;    // body index per particle (index into bodies)
+  std::vector<float> field;      // n values of render.color_by (empty when color_by == "material")
+  std::string field_name;        // e.g. "speed"
+  std::string field_unit;        // e.g. "m/s"
+  std::vector<BodyView> bodies;
+  size_t size() const { return body.size(); }
+};
+
+}  // namespace aortasph

@@ -1,0 +1,360 @@
+#include "world.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "boundary.hpp"
+#include "sim_errors.hpp"
+#include "parallel.hpp"
+#include "shapes.hpp"
+
+namespace aortasph {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+std::string fmt_vec(const Vec3& v) {
+  std::ostringstream s;
+  s << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+  return s.str();
+}
+
+std::array<float, 3> default_color(MaterialType t) {
+  switch (t) {
+    case MaterialType::Fluid: return {0.22f, 0.47f, 0.85f};
+    case MaterialType::Wall: return {0.62f, 0.62f, 0.62f};
+    case MaterialType::Rigid: return {0.90f, 0.50f, 0.15f};
+    case MaterialType::Elastic: return {0.30f, 0.70f, 0.35f};
+  }
+  return {0.5f, 0.5f, 0.5f};
+}
+
+Kind kind_of(MaterialType t) {
+  switch (t) {
+    case MaterialType::Fluid: return Kind::Fluid;
+    case MaterialType::Wall: return Kind::Wall;
+    case MaterialType::Rigid: return Kind::Rigid;
+    case MaterialType::Elastic: return Kind::Elastic;
+  }
+  return Kind::Wall;
+}
+
+}  // namespace
+
+World::World(const Scene& scene)
+    : scene_(scene), kernel_(scene.smoothing_ratio * scene.spacing), gravity_(scene.gravity) {
+  const double dx = scene_.spacing;
+  const double volume = dx * dx * dx;
+
+  // Read-only per-material constants.
+  fluid_.resize(scene_.materials.size());
+  bool have_fluid = false;
+  for (std::size_t m = 0; m < scene_.materials.size(); ++m) {
+    const Material& mat = scene_.materials[m];
+    if (mat.type != MaterialType::Fluid) continue;
+    fluid_[m] = FluidParams(mat);
+    if (!have_fluid) wall_ref_ = fluid_[m];
+    have_fluid = true;
+    max_c0_ = std::max(max_c0_, mat.sound_speed);
+    max_nu_ = std::max(max_nu_, mat.viscosity);
+  }
+  if (!have_fluid) wall_ref_ = FluidParams(Material{});
+
+  // Sample the bodies.
+  for (std::size_t b = 0; b < scene_.bodies.size(); ++b) {
+    const Body& body = scene_.bodies[b];
+    const Material& mat = scene_.materials.at(body.material);
+    const std::string where = "bodies[" + std::to_string(b) + "] '" + body.name + "'";
+    if (mat.type == MaterialType::Rigid || mat.type == MaterialType::Elastic)
+      throw SetupError(where + ": material '" + mat.name + "' is of type " +
+                       (mat.type == MaterialType::Rigid ? "rigid" : "elastic") +
+                       ", which this version cannot simulate yet");
+    ShapeSample sample = sample_body(body, dx);
+    if (sample.points.empty())
+      throw SetupError(where + ": the shape holds no particle at spacing " + std::to_string(dx));
+    if (scene_.bodies.size() > std::numeric_limits<uint16_t>::max())
+      throw SetupError("bodies: too many bodies");
+
+    BodyInfo info;
+    info.name = body.name;
+    info.type = mat.type;
+    info.material = body.material;
+    info.count = sample.points.size();
+    info.mesh = std::move(sample.mesh);
+
+    Vec3 centroid = Vec3::Zero();
+    for (const Vec3& p : sample.points) centroid += p;
+    centroid /= static_cast<double>(sample.points.size());
+
+    const double rho0 = mat.type == MaterialType::Fluid ? mat.density : wall_ref_.rho0;
+    const std::size_t first = P_.size();
+    P_.resize(first + sample.points.size());
+    for (std::size_t k = 0; k < sample.points.size(); ++k) {
+      const std::size_t i = first + k;
+      P_.x[i] = sample.points[k];
+      P_.x0[i] = sample.points[k];
+      P_.kind[i] = kind_of(mat.type);
+      P_.body[i] = static_cast<uint16_t>(b);
+      P_.material[i] = static_cast<uint16_t>(body.material);
+      P_.id[i] = static_cast<uint32_t>(i);
+      P_.m[i] = rho0 * volume;
+      P_.rho[i] = rho0;
+      if (mat.type != MaterialType::Wall)
+        P_.v[i] = body.velocity + body.angular_velocity.cross(sample.points[k] - centroid);
+    }
+
+    // Fluid under gravity starts in hydrostatic balance: p = rho0 |g| depth below the body's top, and the
+    // density that the equation of state gives for it. Without this the column would first oscillate.
+    const double g = gravity_.norm();
+    if (mat.type == MaterialType::Fluid && g > 0.0) {
+      const Vec3 up = -gravity_ / g;
+      double top = std::numeric_limits<double>::lowest();
+      for (const Vec3& p : sample.points) top = std::max(top, up.dot(p));
+      top += 0.5 * dx;
+      for (std::size_t k = 0; k < sample.points.size(); ++k) {
+        const std::size_t i = first + k;
+        const double p = mat.density * g * (top - up.dot(P_.x[i]));
+        P_.rho[i] = fluid_[body.material].density(p);
+        P_.p[i] = fluid_[body.material].pressure(P_.rho[i]);
+      }
+    }
+    bodies_.push_back(std::move(info));
+  }
+  if (P_.size() > std::numeric_limits<uint32_t>::max() / 4) throw SetupError("too many particles");
+
+  // Bodies may touch but not overlap: particles of two bodies closer than half a spacing are an error.
+  nb_.build(P_.x, 0.5 * dx);
+  for (std::size_t i = 0; i < P_.size(); ++i)
+    for (uint32_t k = nb_.begin(i); k < nb_.end(i); ++k) {
+      const uint32_t j = nb_.index()[k];
+      if (P_.body[j] != P_.body[i])
+        throw SetupError("bodies '" + scene_.bodies[P_.body[i]].name + "' and '" + scene_.bodies[P_.body[j]].name +
+                         "' overlap near " + fmt_vec(P_.x[i]) + ": particles closer than half a spacing");
+    }
+
+  for (std::size_t i = 0; i < P_.size(); ++i)
+    if (P_.kind[i] != Kind::Wall) ++moving_at_start_;
+  speed_limit_ = scene_.max_speed > 0.0 ? scene_.max_speed : (max_c0_ > 0.0 ? 2.0 * max_c0_ : 1e3);
+  max_accel_ = gravity_.norm();
+  for (const Vec3& v : P_.v) max_speed_ = std::max(max_speed_, v.norm());
+
+  // Spatial sort once, so neighbours sit close in memory from the first step.
+  nb_.build(P_.x, kernel_.support);
+  P_.permute(nb_.spatial_order());
+  nb_.build(P_.x, kernel_.support);
+  FluidContext ctx{kernel_, fluid_, gravity_};
+  fluid_pressure(P_, ctx);
+  boundary_from_fluid(P_, nb_, ctx, wall_ref_);
+}
+
+std::size_t World::count(Kind k) const {
+  return static_cast<std::size_t>(std::count(P_.kind.begin(), P_.kind.end(), k));
+}
+
+double World::stable_dt() const {
+  const double h = kernel_.h;
+  double dt = scene_.max_dt;
+  // Acoustic CFL (Monaghan 1992): information crosses h in no less than h / (c0 + |v|max).
+  if (max_c0_ > 0.0) dt = std::min(dt, scene_.cfl * h / (max_c0_ + max_speed_));
+  // Viscous diffusion limit (Morris, Fox & Zhu 1997, eq. 18): dt <= 0.125 h^2 / nu.
+  if (max_nu_ > 0.0) dt = std::min(dt, 0.125 * h * h / max_nu_);
+  // Force limit (Monaghan 1992): dt <= 0.25 sqrt(h / |a|max).
+  if (max_accel_ > 0.0) dt = std::min(dt, 0.25 * std::sqrt(h / max_accel_));
+  return dt;
+}
+
+void World::update_neighbors() {
+  auto t0 = Clock::now();
+  nb_.build(P_.x, kernel_.support);
+  profile_.neighbors += seconds_since(t0);
+  // Every few steps, reorder the particles along a Z-order curve of the cells so that neighbours stay close
+  // in memory as the flow mixes them; the list is then rebuilt for the new order.
+  if (steps_ % sort_interval_ == 0 && steps_ > 0) {
+    t0 = Clock::now();
+    P_.permute(nb_.spatial_order());
+    nb_.build(P_.x, kernel_.support);
+    profile_.sort += seconds_since(t0);
+  }
+}
+
+// One time step, Algorithm 1: neighbours -> density -> pressure -> boundary -> forces -> integrate.
+// The density is advanced before the forces are computed, so that the pressure driving v(t + dt) is that of
+// rho(t + dt): with both taken from time t the acoustic modes would grow each step (the explicit Euler scheme
+// is unconditionally unstable for an oscillator); in this order the pair (rho, v) is advanced by the symplectic
+// Euler scheme, as (v, x) is in Algorithm 1 lines 15-16.
+void World::step(double dt) {
+  update_neighbors();
+  FluidContext ctx{kernel_, fluid_, gravity_};
+
+  auto t0 = Clock::now();
+  fluid_density_summation(P_, nb_, ctx);  // eq. (11), where a material asks for it
+  fluid_density_rate(P_, nb_, ctx);       // eq. (12) + diffusion, elsewhere
+  parallel_for(P_.size(), [&](std::size_t i) {
+    if (P_.kind[i] == Kind::Fluid && !fluid_[P_.material[i]].summation) P_.rho[i] += dt * P_.drho[i];
+  });
+  fluid_pressure(P_, ctx);  // eq. (13)
+  profile_.density += seconds_since(t0);
+
+  t0 = Clock::now();
+  boundary_from_fluid(P_, nb_, ctx, wall_ref_);  // Adami et al. 2012
+  profile_.boundary += seconds_since(t0);
+
+  t0 = Clock::now();
+  fluid_forces(P_, nb_, ctx);  // eqs. (9), (10), artificial viscosity, gravity
+  profile_.forces += seconds_since(t0);
+
+  t0 = Clock::now();
+  integrate(dt);
+  check_and_remove(dt);
+  profile_.integrate += seconds_since(t0);
+
+  time_ += dt;
+  last_dt_ = dt;
+  ++steps_;
+}
+
+// Symplectic Euler, Algorithm 1 lines 15-16: v(t + dt) = v + dt a; x(t + dt) = x + dt v(t + dt).
+void World::integrate(double dt) {
+  parallel_for(P_.size(), [&](std::size_t i) {
+    if (P_.kind[i] != Kind::Fluid) return;
+    P_.v[i] += dt * P_.a[i];
+    P_.x[i] += dt * P_.v[i];
+  });
+  struct Extremes {
+    double v2 = 0, a2 = 0;
+  };
+  const Extremes e = parallel_reduce(
+      P_.size(), Extremes{},
+      [&](std::size_t i) {
+        if (P_.kind[i] == Kind::Wall) return Extremes{};
+        return Extremes{P_.v[i].squaredNorm(), P_.a[i].squaredNorm()};
+      },
+      [](const Extremes& a, const Extremes& b) {
+        // std::max drops a NaN on one side; check_and_remove() finds NaNs itself.
+        return Extremes{std::max(a.v2, b.v2), std::max(a.a2, b.a2)};
+      });
+  max_speed_ = std::sqrt(e.v2);
+  max_accel_ = std::max(std::sqrt(e.a2), gravity_.norm());
+}
+
+void World::check_and_remove(double dt) {
+  const std::size_t n = P_.size();
+  const double limit2 = speed_limit_ * speed_limit_;
+  // First offending particle (smallest index): the same answer for any thread count.
+  const std::size_t bad = parallel_reduce(
+      n, n,
+      [&](std::size_t i) {
+        const bool finite = P_.x[i].allFinite() && P_.v[i].allFinite() && std::isfinite(P_.rho[i]);
+        return (!finite || P_.v[i].squaredNorm() > limit2) ? i : n;
+      },
+      [](std::size_t a, std::size_t b) { return std::min(a, b); });
+  if (bad < n) {
+    std::ostringstream msg;
+    const bool finite = P_.x[bad].allFinite() && P_.v[bad].allFinite() && std::isfinite(P_.rho[bad]);
+    msg << "unstable at t = " << time_ + dt << " s, step " << steps_ + 1 << " (dt = " << dt << " s): particle "
+        << P_.id[bad] << " of body '" << scene_.bodies[P_.body[bad]].name << "' at " << fmt_vec(P_.x[bad])
+        << (finite ? " moves at " + std::to_string(P_.v[bad].norm()) + " m/s, over the limit of " +
+                         std::to_string(speed_limit_) + " m/s (time.max_speed)"
+                   : " has a non-finite position, velocity or density");
+    throw InstabilityError(msg.str());
+  }
+
+  // Particles that leave the domain are removed; more than the allowed fraction is an instability.
+  const Box& dom = scene_.domain;
+  const std::size_t outside = parallel_reduce(
+      n, std::size_t{0}, [&](std::size_t i) { return std::size_t{!dom.contains(P_.x[i])}; },
+      [](std::size_t a, std::size_t b) { return a + b; });
+  if (outside == 0) return;
+  std::vector<uint32_t> keep;
+  keep.reserve(n - outside);
+  std::size_t first_out = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (dom.contains(P_.x[i]))
+      keep.push_back(static_cast<uint32_t>(i));
+    else if (first_out == n)
+      first_out = i;
+  }
+  left_domain_ += outside;
+  const double allowed = scene_.max_leave_fraction * static_cast<double>(moving_at_start_);
+  if (static_cast<double>(left_domain_) > allowed) {
+    std::ostringstream msg;
+    msg << "unstable at t = " << time_ + dt << " s, step " << steps_ + 1 << ": " << left_domain_
+        << " particle(s) left the domain (allowed: " << static_cast<std::size_t>(allowed)
+        << ", domain.max_leave_fraction = " << scene_.max_leave_fraction << "); first: particle "
+        << P_.id[first_out] << " of body '" << scene_.bodies[P_.body[first_out]].name << "' at "
+        << fmt_vec(P_.x[first_out]);
+    throw InstabilityError(msg.str());
+  }
+  P_.permute(keep);
+  // The neighbour list refers to old indices; it is rebuilt at the start of the next step.
+}
+
+double World::max_density_error() const {
+  return parallel_reduce(
+      P_.size(), 0.0,
+      [&](std::size_t i) {
+        if (P_.kind[i] != Kind::Fluid) return 0.0;
+        return std::abs(P_.rho[i] / fluid_[P_.material[i]].rho0 - 1.0);
+      },
+      [](double a, double b) { return std::max(a, b); });
+}
+
+std::size_t World::memory_bytes() const {
+  const std::size_t per = sizeof(Vec3) * 5 + sizeof(double) * 4 + sizeof(Kind) + 2 * sizeof(uint16_t) +
+                          sizeof(uint32_t);
+  return per * P_.x.capacity() + nb_.bytes();
+}
+
+Snapshot World::snapshot(const std::string& field, int frame) const {
+  Snapshot s;
+  s.time = time_;
+  s.frame = frame;
+  s.spacing = scene_.spacing;
+  const std::size_t n = P_.size();
+  s.position.resize(3 * n);
+  s.body.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int d = 0; d < 3; ++d) s.position[3 * i + d] = static_cast<float>(P_.x[i][d]);
+    s.body[i] = P_.body[i];
+  }
+  if (field != "material") {
+    s.field_name = field;
+    s.field.resize(n, 0.0f);
+    if (field == "speed") {
+      s.field_unit = "m/s";
+      for (std::size_t i = 0; i < n; ++i) s.field[i] = static_cast<float>(P_.v[i].norm());
+    } else if (field == "pressure") {
+      s.field_unit = "Pa";
+      for (std::size_t i = 0; i < n; ++i) s.field[i] = static_cast<float>(P_.p[i]);
+    } else if (field == "displacement") {
+      s.field_unit = "m";
+      for (std::size_t i = 0; i < n; ++i) s.field[i] = static_cast<float>((P_.x[i] - P_.x0[i]).norm());
+    } else if (field == "stress") {
+      s.field_unit = "Pa";  // von Mises stress of elastic particles; zero elsewhere until solids exist
+    }
+  }
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    const Body& body = scene_.bodies[b];
+    BodyView view;
+    view.name = body.name;
+    view.type = bodies_[b].type;
+    if (body.color)
+      view.color = {static_cast<float>((*body.color)[0]), static_cast<float>((*body.color)[1]),
+                    static_cast<float>((*body.color)[2])};
+    else
+      view.color = default_color(view.type);
+    view.render = body.render;
+    view.mesh = bodies_[b].mesh;  // fixed walls: the mesh of t = 0 is the mesh now
+    s.bodies.push_back(std::move(view));
+  }
+  return s;
+}
+
+}  // namespace aortasph

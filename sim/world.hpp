@@ -1,0 +1,126 @@
+// World: the particles and bodies of one scene, and the time step that advances them.
+// The scene (materials, parameters) is read-only after construction; step() only writes state.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "fluid_wcsph.hpp"
+#include "kernel.hpp"
+#include "neighbors.hpp"
+#include "particles.hpp"
+#include "scene.hpp"
+#include "snapshot.hpp"
+
+namespace aortasph {
+
+// Wall time per phase of the step, summed over steps [s].
+struct Profile {
+  double neighbors = 0, density = 0, boundary = 0, forces = 0, integrate = 0, sort = 0;
+  double total() const { return neighbors + density + boundary + forces + integrate + sort; }
+  // (name, seconds) of each phase, in step order: the one list that diagnostics, run.json and bench print.
+  std::vector<std::pair<std::string, double>> phases() const {
+    return {{"neighbors", neighbors}, {"density", density}, {"boundary", boundary},
+            {"forces", forces},       {"integrate", integrate}, {"sort", sort}};
+  }
+  Profile operator-(const Profile& o) const {
+    return {neighbors - o.neighbors, density - o.density, boundary - o.boundary,
+            forces - o.forces,       integrate - o.integrate, sort - o.sort};
+  }
+};
+
+struct BodyInfo {
+  std::string name;
+  MaterialType type = MaterialType::Fluid;
+  int material = 0;
+  std::size_t count = 0;   // particles at t = 0
+  SurfaceMesh mesh;        // world coordinates at t = 0
+};
+
+class World {
+ public:
+  // Samples every body, sets masses, densities (hydrostatic for fluids under gravity) and velocities.
+  // Throws SetupError when the scene cannot be built (empty body, overlapping bodies, unsupported model).
+  explicit World(const Scene& scene);
+
+  // Largest stable time step now: acoustic CFL, viscous and force limits (Monaghan 1992; Morris et al. 1997)
+  // and the scene's max_dt.
+  double stable_dt() const;
+
+  // One step of length dt (Algorithm 1). Throws InstabilityError on NaN/Inf, a speed over the limit or
+  // particles leaving the domain beyond the allowed fraction.
+  void step(double dt);
+
+  // Advance to exactly t_target, shortening the last step (SPEC: outputs at exact times). on_step() is
+  // called after each step (progress, interruption); returning false stops early. Returns whether t_target
+  // was reached.
+  template <class OnStep>
+  bool advance_to(double t_target, OnStep&& on_step) {
+    while (time_ < t_target) {
+      double dt = stable_dt();
+      const double remaining = t_target - time_;
+      // Never leave a sliver: if two steps would reach the target, split the rest evenly.
+      bool last = false;
+      if (dt >= remaining) {
+        dt = remaining;
+        last = true;
+      } else if (dt * 2.0 > remaining) {
+        dt = 0.5 * remaining;
+      }
+      step(dt);
+      if (last) time_ = t_target;
+      if (!on_step()) return time_ >= t_target;
+    }
+    return true;
+  }
+
+  const Scene& scene() const { return scene_; }
+  const Particles& particles() const { return P_; }
+  const NeighborSearch& neighbors() const { return nb_; }
+  const std::vector<BodyInfo>& bodies() const { return bodies_; }
+  const CubicSpline& kernel() const { return kernel_; }
+  const std::vector<FluidParams>& fluid_params() const { return fluid_; }
+  const Profile& profile() const { return profile_; }
+  double time() const { return time_; }
+  long steps() const { return steps_; }
+  double last_dt() const { return last_dt_; }
+  double max_speed() const { return max_speed_; }
+  double speed_limit() const { return speed_limit_; }
+  std::size_t count(Kind k) const;
+  std::size_t left_domain() const { return left_domain_; }
+  // max |rho / rho0 - 1| over fluid particles.
+  double max_density_error() const;
+  // Bytes held by particle arrays and neighbour lists.
+  std::size_t memory_bytes() const;
+
+  // What the renderer needs; field is one of material, speed, pressure, displacement, stress.
+  Snapshot snapshot(const std::string& field, int frame) const;
+
+ private:
+  void update_neighbors();
+  void integrate(double dt);
+  void check_and_remove(double dt);
+
+  Scene scene_;
+  CubicSpline kernel_;
+  Vec3 gravity_;
+  std::vector<FluidParams> fluid_;  // per material (entries of non-fluid materials unused)
+  FluidParams wall_ref_;            // equation of state that boundary particles use
+  Particles P_;
+  NeighborSearch nb_;
+  std::vector<BodyInfo> bodies_;
+  Profile profile_;
+  double time_ = 0.0;
+  long steps_ = 0;
+  double last_dt_ = 0.0;
+  double max_speed_ = 0.0;
+  double max_accel_ = 0.0;
+  double speed_limit_ = 0.0;
+  double max_c0_ = 0.0;
+  double max_nu_ = 0.0;
+  std::size_t moving_at_start_ = 0;
+  std::size_t left_domain_ = 0;
+  int sort_interval_ = 20;
+};
+
+}  // namespace aortasph

@@ -1,0 +1,75 @@
+// Small scenes built in code for the physics tests.
+#pragma once
+
+#include "scene.hpp"
+
+namespace aortasph::test {
+
+inline Material water(double c0 = 20.0) {
+  Material m;
+  m.name = "water";
+  m.type = MaterialType::Fluid;
+  m.density = 1000.0;
+  m.viscosity = 1e-6;
+  m.sound_speed = c0;
+  return m;
+}
+
+inline Material wall() {
+  Material m;
+  m.name = "wall";
+  m.type = MaterialType::Wall;
+  return m;
+}
+
+inline Body box_body(const std::string& name, int material, Vec3 lo, Vec3 hi, Vec3 velocity = Vec3::Zero()) {
+  Body b;
+  b.name = name;
+  b.material = material;
+  b.shape.kind = ShapeKind::Box;
+  b.shape.box = {lo, hi};
+  b.velocity = velocity;
+  return b;
+}
+
+inline Body container(const std::string& name, int material, Vec3 lo, Vec3 hi, std::vector<std::string> open) {
+  Body b;
+  b.name = name;
+  b.material = material;
+  b.shape.kind = ShapeKind::Container;
+  b.shape.box = {lo, hi};
+  b.shape.layers = 3;
+  b.shape.open = std::move(open);
+  return b;
+}
+
+// Two water cubes flying at each other, off-centre, no walls, no gravity (the paper's Figure 1).
+inline Scene fluid_cubes(double dx) {
+  Scene s;
+  s.name = "cubes";
+  s.spacing = dx;
+  s.gravity = Vec3::Zero();
+  s.domain = {Vec3(-1, -1, -1), Vec3(1, 1, 1)};
+  s.t_end = 0.1;
+  s.max_dt = 1e-3;
+  s.materials = {water(20.0)};
+  s.bodies = {box_body("left", 0, Vec3(-0.12, -0.05, -0.05), Vec3(-0.02, 0.05, 0.05), Vec3(1, 0, 0)),
+              box_body("right", 0, Vec3(0.02, -0.02, -0.05), Vec3(0.12, 0.08, 0.05), Vec3(-1, 0, 0))};
+  return s;
+}
+
+// Martin & Moyce (1952) dam break, column a x 2a, in a tank of length 7a (SPEC's axis convention: +y up).
+inline Scene dam_break(double a, double dx, double depth) {
+  Scene s;
+  s.name = "dam_break_test";
+  s.spacing = dx;
+  s.domain = {Vec3(-0.05, -0.05, -0.05), Vec3(8 * a + 0.05, 3 * a + 0.05, depth + 0.05)};
+  s.t_end = 0.2;
+  s.max_dt = 1e-3;
+  s.materials = {water(10.0 * std::sqrt(2.0 * 9.81 * 2.0 * a)), wall()};
+  s.bodies = {box_body("column", 0, Vec3(0, 0, 0), Vec3(a, 2 * a, depth)),
+              container("tank", 1, Vec3(0, 0, 0), Vec3(8 * a, 3 * a, depth), {"+y"})};
+  return s;
+}
+
+}  // namespace aortasph::test
