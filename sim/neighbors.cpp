@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "parallel.hpp"
 
@@ -27,7 +28,7 @@ struct BoundsAcc {
 
 }  // namespace
 
-void NeighborSearch::build(const std::vector<Vec3>& x, double radius) {
+void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std::vector<uint8_t>& fixed) {
   const std::size_t n = x.size();
   offset_.assign(n + 1, 0);
   index_.clear();
@@ -74,6 +75,15 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius) {
     for (std::size_t i = 0; i < n; ++i) cell_items_[fill[cell_of_[i]]++] = static_cast<uint32_t>(i);
   }
 
+  // Cells that hold a particle that is not fixed: a fixed particle needs neighbours only near one.
+  const bool any_fixed = !fixed.empty();
+  std::vector<uint8_t> cell_moving;
+  if (any_fixed) {
+    cell_moving.assign(ncell, 0);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!fixed[i]) cell_moving[cell_of_[i]] = 1;
+  }
+
   const double r2 = radius * radius;
   // Visit the candidates of i in a fixed order; call found(j) for each neighbour.
   auto visit = [&](std::size_t i, auto&& found) {
@@ -81,32 +91,44 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius) {
     const int cx = static_cast<int>(c % dims_[0]);
     const int cy = static_cast<int>((c / dims_[0]) % dims_[1]);
     const int cz = static_cast<int>(c / (static_cast<std::size_t>(dims_[0]) * dims_[1]));
+    const int x0 = std::max(cx - 1, 0), x1 = std::min(cx + 1, dims_[0] - 1);
+    const bool fixed_i = any_fixed && fixed[i];
     const Vec3 xi = x[i];
     for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, dims_[2] - 1); ++z)
       for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, dims_[1] - 1); ++y) {
         const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
-        const uint32_t b = cell_start_[row + std::max(cx - 1, 0)];
-        const uint32_t e = cell_start_[row + std::min(cx + 1, dims_[0] - 1) + 1];
+        if (fixed_i && !cell_moving[row + x0] && !cell_moving[row + cx] && !cell_moving[row + x1]) continue;
         // Cells x-1, x, x+1 of one row are contiguous in cell_items_.
-        for (uint32_t k = b; k < e; ++k) {
+        for (uint32_t k = cell_start_[row + x0]; k < cell_start_[row + x1 + 1]; ++k) {
           const uint32_t j = cell_items_[k];
-          if (j == i) continue;
+          if (j == i || (fixed_i && fixed[j])) continue;
           if ((x[j] - xi).squaredNorm() < r2) found(j);
         }
       }
   };
 
-  // Two passes, count then fill, so that the list is written without locks or per-thread buffers.
-  parallel_for_dynamic(n, [&](std::size_t i) {
-    uint32_t count = 0;
-    visit(i, [&](uint32_t) { ++count; });
-    offset_[i + 1] = count;
+  // One pass over fixed, contiguous chunks of particles (their number does not depend on the thread count),
+  // each into its own buffer; the buffers are then concatenated in chunk order.
+  const std::size_t chunks = std::clamp<std::size_t>(n / 512, 1, 1024);
+  std::vector<std::vector<uint32_t>> local(chunks);
+  parallel_for_dynamic_chunks(chunks, [&](std::size_t c) {
+    const std::size_t b = n * c / chunks, e = n * (c + 1) / chunks;
+    auto& out = local[c];
+    out.reserve((e - b) * 64);
+    for (std::size_t i = b; i < e; ++i) {
+      visit(i, [&](uint32_t j) { out.push_back(j); });
+      offset_[i + 1] = static_cast<uint32_t>(out.size());  // local count, made global below
+    }
   });
-  for (std::size_t i = 0; i < n; ++i) offset_[i + 1] += offset_[i];
-  index_.resize(offset_[n]);
-  parallel_for_dynamic(n, [&](std::size_t i) {
-    uint32_t k = offset_[i];
-    visit(i, [&](uint32_t j) { index_[k++] = j; });
+  std::vector<std::size_t> chunk_base(chunks + 1, 0);
+  for (std::size_t c = 0; c < chunks; ++c) chunk_base[c + 1] = chunk_base[c] + local[c].size();
+  if (chunk_base[chunks] > std::numeric_limits<uint32_t>::max())
+    throw std::length_error("neighbour list over 4e9 pairs: reduce the resolution");
+  index_.resize(chunk_base[chunks]);
+  parallel_for_dynamic_chunks(chunks, [&](std::size_t c) {
+    const std::size_t b = n * c / chunks, e = n * (c + 1) / chunks;
+    for (std::size_t i = b; i < e; ++i) offset_[i + 1] += static_cast<uint32_t>(chunk_base[c]);
+    std::copy(local[c].begin(), local[c].end(), index_.begin() + static_cast<std::ptrdiff_t>(chunk_base[c]));
   });
 }
 

@@ -14,8 +14,10 @@ namespace aortasph {
 
 class NeighborSearch {
  public:
-  // All pairs i != j with |x_i - x_j| < radius.
-  void build(const std::vector<Vec3>& x, double radius);
+  // All pairs i != j with |x_i - x_j| < radius, except pairs of two fixed particles (fixed[i] && fixed[j]):
+  // fixed walls never interact with each other, and a wall far from anything that moves gets an empty list
+  // at almost no cost. fixed may be empty (no fixed particle).
+  void build(const std::vector<Vec3>& x, double radius, const std::vector<uint8_t>& fixed = {});
 
   std::size_t size() const { return offset_.empty() ? 0 : offset_.size() - 1; }
   uint32_t begin(std::size_t i) const { return offset_[i]; }

@@ -25,6 +25,14 @@ void parallel_for_dynamic(std::size_t n, F&& f) {
   for (std::ptrdiff_t i = 0; i < count; ++i) f(static_cast<std::size_t>(i));
 }
 
+// One item at a time to whichever thread is free: for a few large, uneven work items.
+template <class F>
+void parallel_for_dynamic_chunks(std::size_t n, F&& f) {
+  const auto count = static_cast<std::ptrdiff_t>(n);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::ptrdiff_t i = 0; i < count; ++i) f(static_cast<std::size_t>(i));
+}
+
 inline constexpr std::size_t kReduceBlock = 4096;
 
 // value(i) -> T; combine(T, T) -> T. Blocks of kReduceBlock items are folded left to right, then the block

@@ -146,9 +146,9 @@ World::World(const Scene& scene)
   for (const Vec3& v : P_.v) max_speed_ = std::max(max_speed_, v.norm());
 
   // Spatial sort once, so neighbours sit close in memory from the first step.
-  nb_.build(P_.x, kernel_.support);
+  nb_.build(P_.x, kernel_.support, fixed_mask());
   P_.permute(nb_.spatial_order());
-  nb_.build(P_.x, kernel_.support);
+  nb_.build(P_.x, kernel_.support, fixed_mask());
   FluidContext ctx{kernel_, fluid_, gravity_};
   fluid_pressure(P_, ctx);
   boundary_from_fluid(P_, nb_, ctx, wall_ref_);
@@ -170,16 +170,22 @@ double World::stable_dt() const {
   return dt;
 }
 
+std::vector<uint8_t> World::fixed_mask() const {
+  std::vector<uint8_t> fixed(P_.size());
+  for (std::size_t i = 0; i < P_.size(); ++i) fixed[i] = P_.kind[i] == Kind::Wall;
+  return fixed;
+}
+
 void World::update_neighbors() {
   auto t0 = Clock::now();
-  nb_.build(P_.x, kernel_.support);
+  nb_.build(P_.x, kernel_.support, fixed_mask());
   profile_.neighbors += seconds_since(t0);
   // Every few steps, reorder the particles along a Z-order curve of the cells so that neighbours stay close
   // in memory as the flow mixes them; the list is then rebuilt for the new order.
   if (steps_ % sort_interval_ == 0 && steps_ > 0) {
     t0 = Clock::now();
     P_.permute(nb_.spatial_order());
-    nb_.build(P_.x, kernel_.support);
+    nb_.build(P_.x, kernel_.support, fixed_mask());
     profile_.sort += seconds_since(t0);
   }
 }

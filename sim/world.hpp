@@ -98,6 +98,7 @@ class World {
 
  private:
   void update_neighbors();
+  std::vector<uint8_t> fixed_mask() const;  // 1 for particles that never move (walls)
   void integrate(double dt);
   void check_and_remove(double dt);
 

@@ -140,3 +140,55 @@ TEST_CASE("a water column at rest: hydrostatic pressure, no leak, flat surface",
   CHECK(hi - lo < dx);
   CHECK(w.max_speed() < 0.05);
 }
+
+namespace {
+
+// (T, Z) rows of a validation CSV in ../shared/validation (first line: the source; second: the header).
+std::vector<std::pair<double, double>> read_reference(const std::string& file) {
+  std::ifstream f(std::string(AORTASPH_TEST_DIR) + "/../../shared/validation/" + file);
+  if (!f) f.open(std::string(AORTASPH_TEST_DIR) + "/data/" + file);
+  std::vector<std::pair<double, double>> rows;
+  std::string line;
+  while (std::getline(f, line)) {
+    if (line.empty() || line[0] == '#' || !(std::isdigit(line[0]) || line[0] == '.')) continue;
+    std::istringstream s(line);
+    double t, z;
+    char comma;
+    if (s >> t >> comma >> z) rows.emplace_back(t, z);
+  }
+  return rows;
+}
+
+}  // namespace
+
+// Martin & Moyce (1952) surge front, n^2 = 2, against their tabulated data (a = 2.25 in), at the resolution the
+// test suite affords: a / 10 (800 fluid particles in a slab 4 particles deep). The simulated front runs ahead
+// of the experiment early on: +12 to +13 % for T = 1.2 to 1.8 (the experiment's gate and bottom friction slow
+// it; finer resolution does not close the gap, see docs/validation.md). This MISSES the 10 % target for
+// T < 2.3; the test asserts the 10 % band from T = 2.3 to 3 and pins the early lead below 14 %, so that any
+// change that moves the front either way is caught.
+TEST_CASE("dam break surge front follows Martin & Moyce", "[fluid][validation]") {
+  const auto data = read_reference("dambreak_martin_moyce_tables_n2_2_a225in_front.csv");
+  REQUIRE(data.size() >= 10);
+  const double a = 0.05715, dx = a / 10;
+  World w(dam_break(a, dx, 4 * dx));
+  const double scale = std::sqrt(2.0 * 9.81 / a);  // T = t sqrt(2 g / a)
+  int compared = 0;
+  for (const auto& [T, Z] : data) {
+    if (T < 1.0 || T > 3.0) continue;
+    w.advance_to(T / scale, [] { return true; });
+    double front = 0.0;
+    const Particles& P = w.particles();
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (P.kind[i] == Kind::Fluid) front = std::max(front, P.x[i].x());
+    const double err = front / a / Z - 1.0;
+    INFO("T = " << T << ": Z sim " << front / a << ", experiment " << Z << ", error " << 100 * err << " %");
+    CHECK(err > -0.10);  // never behind the experiment by more than 10 %
+    if (T >= 2.3)
+      CHECK(err < 0.10);
+    else
+      CHECK(err < 0.14);
+    ++compared;
+  }
+  CHECK(compared >= 8);
+}
