@@ -26,10 +26,20 @@ void fluid_pressure(Particles& P, const FluidContext& ctx) {
   });
 }
 
+void fluid_pair_terms(const Particles& P, FluidContext& ctx) {
+  ctx.p_over_rho2.resize(P.size());
+  ctx.volume.resize(P.size());
+  parallel_for(P.size(), [&](std::size_t i) {
+    ctx.p_over_rho2[i] = P.p[i] / (P.rho[i] * P.rho[i]);
+    ctx.volume[i] = P.m[i] / P.rho[i];
+  });
+}
+
 void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidContext& ctx) {
   const auto& idx = nb.index();
   const CubicSpline& K = ctx.kernel;
   const double h = K.h;
+  const double support2 = K.support * K.support;
   parallel_for_dynamic(P.size(), [&](std::size_t i) {
     if (P.kind[i] != Kind::Fluid) return;
     const FluidParams& fi = ctx.params[P.material[i]];
@@ -43,8 +53,9 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
       const Vec3 xij = xi - P.x[j];
-      const double r = xij.norm();
-      if (r <= 0.0) continue;
+      const double r2 = xij.squaredNorm();
+      if (r2 >= support2 || r2 <= 0.0) continue;  // Verlet-list pairs in the skin: the kernel is zero there
+      const double r = std::sqrt(r2);
       const double dwdr_r = K.dWdr(r) / r;
       // Continuity, eq. (12) with x_ij = x_i - x_j, v_ij = v_i - v_j (the paper's minus sign belongs to
       // v_ji): approaching particles compress. A boundary particle contributes with its own velocity: this is
@@ -54,7 +65,7 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
       // hydrostatic density difference rho0 g.x_ji / c0^2 (Fourtakas et al. 2019, eq. 19, linearised Tait).
       if (diffusion > 0.0 && P.kind[j] == Kind::Fluid && P.material[j] == P.material[i]) {
         const double hydro = fi.rho0 * ctx.gravity.dot(P.x[j] - xi) * inv_c2;
-        drho -= diffusion * (P.rho[j] - rhoi - hydro) * dwdr_r * (P.m[j] / P.rho[j]);
+        drho -= diffusion * (P.rho[j] - rhoi - hydro) * dwdr_r * ctx.volume[j];
       }
     }
     P.drho[i] = drho;
@@ -66,6 +77,7 @@ void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ct
   const CubicSpline& K = ctx.kernel;
   const double h = K.h;
   const double eta2 = 0.01 * h * h;  // the 0.01 h^2 of eq. (10): keeps the sum finite as r -> 0
+  const double support2 = K.support * K.support;
 
   parallel_for_dynamic(P.size(), [&](std::size_t i) {
     if (P.kind[i] != Kind::Fluid) return;
@@ -73,15 +85,17 @@ void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ct
     const Vec3 xi = P.x[i];
     const Vec3 vi = P.v[i];
     const double rhoi = P.rho[i];
-    const double pi_term = P.p[i] / (rhoi * rhoi);
+    const double pi_term = ctx.p_over_rho2[i];
 
     Vec3 acc = Vec3::Zero();
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
       const Vec3 xij = xi - P.x[j];
-      const double r = xij.norm();
+      const double r2 = xij.squaredNorm();
+      if (r2 >= support2 || r2 <= 0.0) continue;  // Verlet-list pairs in the skin: the kernel is zero there
+      const double r = std::sqrt(r2);
       const double dwdr = K.dWdr(r);
-      const Vec3 gradW = (r > 0.0 ? dwdr / r : 0.0) * xij;  // grad_i W_ij
+      const Vec3 gradW = (dwdr / r) * xij;  // grad_i W_ij
       const double mj = P.m[j];
       const double rhoj = P.rho[j];
       const bool fluid_j = P.kind[j] == Kind::Fluid;
@@ -89,14 +103,14 @@ void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ct
 
       // Pressure, eq. (9) with the 1/rho_i of Algorithm 1 line 9 applied: a_i = -sum m_j (p_i/rho_i^2 +
       // p_j/rho_j^2) grad W. The factor is symmetric in i and j, so pair forces cancel exactly.
-      double scalar = -(pi_term + P.p[j] / (rhoj * rhoj));
+      double scalar = -(pi_term + ctx.p_over_rho2[j]);
 
       // Artificial viscosity (Monaghan 1992): only for approaching pairs.
       if (fi.alpha > 0.0) {
         const double vx = vij.dot(xij);
         if (vx < 0.0) {
           const double cbar = fluid_j ? 0.5 * (fi.c0 + ctx.params[P.material[j]].c0) : fi.c0;
-          const double mu = h * vx / (r * r + eta2);
+          const double mu = h * vx / (r2 + eta2);
           scalar += fi.alpha * cbar * mu / (0.5 * (rhoi + rhoj));  // -Pi_ij, Pi_ij = -alpha c mu / rho
         }
       }
@@ -109,7 +123,7 @@ void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ct
       const double nu = fluid_j ? 0.5 * (fi.nu + ctx.params[P.material[j]].nu) : fi.nu;
       if (nu > 0.0) {
         const Vec3 vij_visc = fluid_j ? vij : Vec3(vi - P.v_wall[j]);
-        const double f = nu * mj * (1.0 / rhoi + 1.0 / rhoj) * (r * dwdr) / (r * r + eta2);
+        const double f = nu * mj * (1.0 / rhoi + 1.0 / rhoj) * (r * dwdr) / (r2 + eta2);
         acc += f * vij_visc;
       }
     }

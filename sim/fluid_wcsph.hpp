@@ -55,7 +55,13 @@ struct FluidContext {
   const CubicSpline& kernel;
   const std::vector<FluidParams>& params;  // indexed by material; only fluid entries are valid
   Vec3 gravity;
+  // Per-particle factors of the pair sums, computed once per step instead of once per pair.
+  std::vector<double> p_over_rho2;  // p / rho^2
+  std::vector<double> volume;       // m / rho
 };
+
+// Fills ctx.p_over_rho2 and ctx.volume from the current p and rho.
+void fluid_pair_terms(const Particles& P, FluidContext& ctx);
 
 // Density by summation, eq. (11), for fluid particles whose material asks for it.
 void fluid_density_summation(Particles& P, const NeighborSearch& nb, const FluidContext& ctx);

@@ -49,7 +49,10 @@ Kind kind_of(MaterialType t) {
 }  // namespace
 
 World::World(const Scene& scene)
-    : scene_(scene), kernel_(scene.smoothing_ratio * scene.spacing), gravity_(scene.gravity) {
+    : scene_(scene),
+      kernel_(scene.smoothing_ratio * scene.spacing),
+      gravity_(scene.gravity),
+      ctx_{kernel_, fluid_, gravity_, {}, {}} {
   const double dx = scene_.spacing;
   const double volume = dx * dx * dx;
 
@@ -146,12 +149,12 @@ World::World(const Scene& scene)
   for (const Vec3& v : P_.v) max_speed_ = std::max(max_speed_, v.norm());
 
   // Spatial sort once, so neighbours sit close in memory from the first step.
+  skin_ = 0.1 * kernel_.support;
   nb_.build(P_.x, kernel_.support, fixed_mask());
   P_.permute(nb_.spatial_order());
-  nb_.build(P_.x, kernel_.support, fixed_mask());
-  FluidContext ctx{kernel_, fluid_, gravity_};
-  fluid_pressure(P_, ctx);
-  boundary_from_fluid(P_, nb_, ctx, wall_ref_);
+  build_lists();
+  fluid_pressure(P_, ctx_);
+  boundary_from_fluid(P_, nb_, ctx_, wall_ref_);
 }
 
 std::size_t World::count(Kind k) const {
@@ -176,18 +179,37 @@ std::vector<uint8_t> World::fixed_mask() const {
   return fixed;
 }
 
+// Verlet lists (Verlet 1967): the lists hold every pair closer than the kernel support plus a skin, and are
+// rebuilt only when some particle has moved half a skin since the last build, so no pair within the support can
+// be missing. Pairs between support and support + skin cost a little in every loop (the kernel is zero there)
+// and save most rebuilds. Every few rebuilds the particles are also re-sorted along a Z-order curve of the
+// cells so that neighbours stay close in memory as the flow mixes them.
 void World::update_neighbors() {
-  auto t0 = Clock::now();
-  nb_.build(P_.x, kernel_.support, fixed_mask());
+  const auto t0 = Clock::now();
+  if (!lists_valid_) {
+    build_lists();
+  } else {
+    const std::size_t n = P_.size();
+    const double moved2 = parallel_reduce(
+        n, 0.0, [&](std::size_t i) { return (P_.x[i] - x_at_build_[i]).squaredNorm(); },
+        [](double a, double b) { return std::max(a, b); });
+    if (4.0 * moved2 >= skin_ * skin_) build_lists();
+  }
   profile_.neighbors += seconds_since(t0);
-  // Every few steps, reorder the particles along a Z-order curve of the cells so that neighbours stay close
-  // in memory as the flow mixes them; the list is then rebuilt for the new order.
-  if (steps_ % sort_interval_ == 0 && steps_ > 0) {
-    t0 = Clock::now();
+}
+
+void World::build_lists() {
+  const double radius = kernel_.support + skin_;
+  nb_.build(P_.x, radius, fixed_mask());
+  if (builds_ % sort_every_builds_ == sort_every_builds_ - 1) {
+    const auto t0 = Clock::now();
     P_.permute(nb_.spatial_order());
-    nb_.build(P_.x, kernel_.support, fixed_mask());
+    nb_.build(P_.x, radius, fixed_mask());
     profile_.sort += seconds_since(t0);
   }
+  ++builds_;
+  x_at_build_ = P_.x;
+  lists_valid_ = true;
 }
 
 // One time step, Algorithm 1: neighbours -> density -> pressure -> boundary -> forces -> integrate.
@@ -197,10 +219,11 @@ void World::update_neighbors() {
 // Euler scheme, as (v, x) is in Algorithm 1 lines 15-16.
 void World::step(double dt) {
   update_neighbors();
-  FluidContext ctx{kernel_, fluid_, gravity_};
+  FluidContext& ctx = ctx_;
 
   auto t0 = Clock::now();
   fluid_density_summation(P_, nb_, ctx);  // eq. (11), where a material asks for it
+  fluid_pair_terms(P_, ctx);
   fluid_density_rate(P_, nb_, ctx);       // eq. (12) + diffusion, elsewhere
   parallel_for(P_.size(), [&](std::size_t i) {
     if (P_.kind[i] == Kind::Fluid && !fluid_[P_.material[i]].summation) P_.rho[i] += dt * P_.drho[i];
@@ -210,6 +233,7 @@ void World::step(double dt) {
 
   t0 = Clock::now();
   boundary_from_fluid(P_, nb_, ctx, wall_ref_);  // Adami et al. 2012
+  fluid_pair_terms(P_, ctx);
   profile_.boundary += seconds_since(t0);
 
   t0 = Clock::now();
@@ -299,7 +323,7 @@ void World::check_and_remove(double dt) {
     throw InstabilityError(msg.str());
   }
   P_.permute(keep);
-  // The neighbour list refers to old indices; it is rebuilt at the start of the next step.
+  lists_valid_ = false;  // the lists refer to the old indices
 }
 
 double World::max_density_error() const {

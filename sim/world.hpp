@@ -98,6 +98,7 @@ class World {
 
  private:
   void update_neighbors();
+  void build_lists();
   std::vector<uint8_t> fixed_mask() const;  // 1 for particles that never move (walls)
   void integrate(double dt);
   void check_and_remove(double dt);
@@ -107,6 +108,7 @@ class World {
   Vec3 gravity_;
   std::vector<FluidParams> fluid_;  // per material (entries of non-fluid materials unused)
   FluidParams wall_ref_;            // equation of state that boundary particles use
+  FluidContext ctx_;  // refers to kernel_ and fluid_; holds per-step scratch arrays
   Particles P_;
   NeighborSearch nb_;
   std::vector<BodyInfo> bodies_;
@@ -121,7 +123,12 @@ class World {
   double max_nu_ = 0.0;
   std::size_t moving_at_start_ = 0;
   std::size_t left_domain_ = 0;
-  int sort_interval_ = 20;
+  // Verlet lists: built with radius support + skin, rebuilt when a particle has moved skin / 2.
+  double skin_ = 0.0;
+  bool lists_valid_ = false;
+  long builds_ = 0;
+  int sort_every_builds_ = 4;
+  std::vector<Vec3> x_at_build_;
 };
 
 }  // namespace aortasph

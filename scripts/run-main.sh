@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# The main job: install, build (Release) and run the showcase scene into out/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+scripts/build.sh build
+./build/aortasph run scenes/dam_break.json --out out/dam_break "$@"
