@@ -162,6 +162,7 @@ std::size_t World::count(Kind k) const {
 }
 
 double World::stable_dt() const {
+  if (scene_.fixed_dt > 0.0) return scene_.fixed_dt;
   const double h = kernel_.h;
   double dt = scene_.max_dt;
   // Acoustic CFL (Monaghan 1992): information crosses h in no less than h / (c0 + |v|max).
