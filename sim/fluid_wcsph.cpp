@@ -72,62 +72,96 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
   });
 }
 
+namespace {
+
+// Acceleration of fluid particle i due to particle j (fluid or boundary): one term of the sums of eqs. (9) and
+// (10) plus artificial viscosity. Zero beyond the kernel support. The same function gives the reaction on a
+// moving boundary particle, so the force a body receives is exactly minus what the fluid feels.
+// What the pair terms need of particle i, loaded once per particle rather than once per pair.
+struct FluidI {
+  std::size_t i;
+  Vec3 x, v;
+  double rho, p_over_rho2;
+  const FluidParams* params;
+  FluidI(const Particles& P, const FluidContext& ctx, std::size_t i)
+      : i(i), x(P.x[i]), v(P.v[i]), rho(P.rho[i]), p_over_rho2(ctx.p_over_rho2[i]), params(&ctx.params[P.material[i]]) {}
+};
+
+struct PairConstants {
+  double h, eta2, support2;
+  explicit PairConstants(const CubicSpline& K)
+      : h(K.h), eta2(0.01 * K.h * K.h), support2(K.support * K.support) {}  // 0.01 h^2 of eq. (10)
+};
+
+inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx, const PairConstants& c, const FluidI& I,
+                              std::size_t j) {
+  const Vec3 xij = I.x - P.x[j];
+  const double r2 = xij.squaredNorm();
+  if (r2 >= c.support2 || r2 <= 0.0) return Vec3::Zero();  // Verlet-list pairs in the skin
+  const FluidParams& fi = *I.params;
+  const double h = c.h, eta2 = c.eta2;
+  const double r = std::sqrt(r2);
+  const double dwdr = ctx.kernel.dWdr(r);
+  const Vec3 gradW = (dwdr / r) * xij;  // grad_i W_ij
+  const double mj = P.m[j];
+  const double rhoi = I.rho;
+  const double rhoj = P.rho[j];
+  const bool fluid_j = P.kind[j] == Kind::Fluid;
+  const Vec3 vij = I.v - P.v[j];
+
+  // Pressure, eq. (9) with the 1/rho_i of Algorithm 1 line 9 applied: a_i = -sum m_j (p_i/rho_i^2 +
+  // p_j/rho_j^2) grad W. The factor is symmetric in i and j, so pair forces cancel exactly.
+  double scalar = -(I.p_over_rho2 + ctx.p_over_rho2[j]);
+
+  // Artificial viscosity (Monaghan 1992): only for approaching pairs.
+  if (fi.alpha > 0.0) {
+    const double vx = vij.dot(xij);
+    if (vx < 0.0) {
+      const double cbar = fluid_j ? 0.5 * (fi.c0 + ctx.params[P.material[j]].c0) : fi.c0;
+      const double mu = h * vx / (r2 + eta2);
+      scalar += fi.alpha * cbar * mu / (0.5 * (rhoi + rhoj));  // -Pi_ij, Pi_ij = -alpha c mu / rho
+    }
+  }
+  Vec3 acc = (mj * scalar) * gradW;
+
+  // Viscosity, eq. (10), in the form symmetric in i and j (Morris, Fox & Zhu 1997, eq. 8): 2/rho_j becomes
+  // 1/rho_i + 1/rho_j, equal to eq. (10) at uniform density and exactly momentum conserving. Boundary particles
+  // use their extrapolated no-slip velocity (Adami et al. 2012, eq. 22): a moving wall's velocity enters the
+  // viscous force here.
+  const double nu = fluid_j ? 0.5 * (fi.nu + ctx.params[P.material[j]].nu) : fi.nu;
+  if (nu > 0.0) {
+    const Vec3 vij_visc = fluid_j ? vij : Vec3(I.v - P.v_wall[j]);
+    const double f = nu * mj * (1.0 / rhoi + 1.0 / rhoj) * (r * dwdr) / (r2 + eta2);
+    acc += f * vij_visc;
+  }
+  return acc;
+}
+
+}  // namespace
+
 void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ctx) {
   const auto& idx = nb.index();
-  const CubicSpline& K = ctx.kernel;
-  const double h = K.h;
-  const double eta2 = 0.01 * h * h;  // the 0.01 h^2 of eq. (10): keeps the sum finite as r -> 0
-  const double support2 = K.support * K.support;
-
+  const PairConstants c(ctx.kernel);
   parallel_for_dynamic(P.size(), [&](std::size_t i) {
     if (P.kind[i] != Kind::Fluid) return;
-    const FluidParams& fi = ctx.params[P.material[i]];
-    const Vec3 xi = P.x[i];
-    const Vec3 vi = P.v[i];
-    const double rhoi = P.rho[i];
-    const double pi_term = ctx.p_over_rho2[i];
-
+    const FluidI I(P, ctx, i);
     Vec3 acc = Vec3::Zero();
-    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
-      const uint32_t j = idx[k];
-      const Vec3 xij = xi - P.x[j];
-      const double r2 = xij.squaredNorm();
-      if (r2 >= support2 || r2 <= 0.0) continue;  // Verlet-list pairs in the skin: the kernel is zero there
-      const double r = std::sqrt(r2);
-      const double dwdr = K.dWdr(r);
-      const Vec3 gradW = (dwdr / r) * xij;  // grad_i W_ij
-      const double mj = P.m[j];
-      const double rhoj = P.rho[j];
-      const bool fluid_j = P.kind[j] == Kind::Fluid;
-      const Vec3 vij = vi - P.v[j];
-
-      // Pressure, eq. (9) with the 1/rho_i of Algorithm 1 line 9 applied: a_i = -sum m_j (p_i/rho_i^2 +
-      // p_j/rho_j^2) grad W. The factor is symmetric in i and j, so pair forces cancel exactly.
-      double scalar = -(pi_term + ctx.p_over_rho2[j]);
-
-      // Artificial viscosity (Monaghan 1992): only for approaching pairs.
-      if (fi.alpha > 0.0) {
-        const double vx = vij.dot(xij);
-        if (vx < 0.0) {
-          const double cbar = fluid_j ? 0.5 * (fi.c0 + ctx.params[P.material[j]].c0) : fi.c0;
-          const double mu = h * vx / (r2 + eta2);
-          scalar += fi.alpha * cbar * mu / (0.5 * (rhoi + rhoj));  // -Pi_ij, Pi_ij = -alpha c mu / rho
-        }
-      }
-      acc += (mj * scalar) * gradW;
-
-      // Viscosity, eq. (10), in the form symmetric in i and j (Morris, Fox & Zhu 1997, eq. 8): 2/rho_j becomes
-      // 1/rho_i + 1/rho_j, equal to eq. (10) at uniform density and exactly momentum conserving. Boundary
-      // particles use their extrapolated no-slip velocity (Adami et al. 2012, eq. 22): the wall's own velocity
-      // enters the viscous force here.
-      const double nu = fluid_j ? 0.5 * (fi.nu + ctx.params[P.material[j]].nu) : fi.nu;
-      if (nu > 0.0) {
-        const Vec3 vij_visc = fluid_j ? vij : Vec3(vi - P.v_wall[j]);
-        const double f = nu * mj * (1.0 / rhoi + 1.0 / rhoj) * (r * dwdr) / (r2 + eta2);
-        acc += f * vij_visc;
-      }
-    }
+    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) acc += pair_acceleration(P, ctx, c, I, idx[k]);
     P.a[i] = acc + ctx.gravity;
+  });
+}
+
+void fluid_reaction(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx, std::vector<Vec3>& f) {
+  const auto& idx = nb.index();
+  const PairConstants c(ctx.kernel);
+  parallel_for_dynamic(P.size(), [&](std::size_t j) {
+    if (P.kind[j] == Kind::Fluid || P.kind[j] == Kind::Wall) return;
+    Vec3 sum = Vec3::Zero();
+    for (uint32_t k = nb.begin(j); k < nb.end(j); ++k) {
+      const uint32_t i = idx[k];
+      if (P.kind[i] == Kind::Fluid) sum -= P.m[i] * pair_acceleration(P, ctx, c, FluidI(P, ctx, i), j);
+    }
+    f[j] += sum;
   });
 }
 

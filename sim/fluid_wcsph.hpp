@@ -76,4 +76,9 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
 // Gathers: each fluid particle writes only its own a.
 void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ctx);
 
+// Adds to f[j], for every moving boundary particle j (rigid, elastic), the force the fluid exerts on it: minus
+// the sum of m_i a_ij over its fluid neighbours i, with the very pair terms of fluid_forces (Newton's third law;
+// Adami et al. 2012 section 2.4).
+void fluid_reaction(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx, std::vector<Vec3>& f);
+
 }  // namespace aortasph

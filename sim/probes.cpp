@@ -33,7 +33,11 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
       case ProbeType::Extent:
       case ProbeType::Pressure:
       case ProbeType::FlowRate: columns_.push_back(pr.name); break;
-      case ProbeType::BodyState: add_columns(columns_, pr.name, {"x", "y", "z", "vx", "vy", "vz", "px", "py", "pz"}); break;
+      case ProbeType::BodyState:
+        add_columns(columns_, pr.name, {"x", "y", "z", "vx", "vy", "vz", "px", "py", "pz"});
+        if (world.bodies()[pr.body].rigid >= 0)
+          add_columns(columns_, pr.name, {"wx", "wy", "wz", "qw", "qx", "qy", "qz"});
+        break;
       case ProbeType::Point: {
         add_columns(columns_, pr.name, {"ux", "uy", "uz", "vx", "vy", "vz", "stress"});
         // The particle of the body nearest the reference point at t = 0 (lowest id on ties).
@@ -104,6 +108,13 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         break;
       }
       case ProbeType::BodyState: {
+        if (const int r = world.bodies()[pr.body].rigid; r >= 0) {
+          const RigidBody& b = world.rigid_bodies()[r];
+          const Vec3 v = b.velocity(), w = b.omega();
+          out.insert(out.end(), {b.com.x(), b.com.y(), b.com.z(), v.x(), v.y(), v.z(), b.P.x(), b.P.y(), b.P.z(),
+                                 w.x(), w.y(), w.z(), b.q.w(), b.q.x(), b.q.y(), b.q.z()});
+          break;
+        }
         // Centre of mass, its velocity and the body's momentum.
         const Sum3 s = parallel_reduce(
             n, Sum3{},
@@ -142,23 +153,32 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const E e = parallel_reduce(
             n, E{},
             [&](std::size_t i) {
-              if (P.kind[i] == Kind::Wall) return E{};
+              if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid) return E{};
               return E{0.5 * P.m[i] * P.v[i].squaredNorm(), -P.m[i] * g.dot(P.x[i])};
             },
             [](const E& a, const E& b) { return E{a.kin + b.kin, a.pot + b.pot}; });
+        // Rigid bodies: translation and rotation, eq. (21), and the potential of the centre of mass.
+        double kin = e.kin, pot = e.pot;
+        for (const RigidBody& b : world.rigid_bodies()) {
+          kin += b.kinetic_energy();
+          pot -= b.mass * g.dot(b.com);
+        }
         const double elastic = 0.0;
-        out.insert(out.end(), {e.kin, e.pot, elastic, e.kin + e.pot + elastic});
+        out.insert(out.end(), {kin, pot, elastic, kin + pot + elastic});
         break;
       }
       case ProbeType::Momentum: {
-        const Sum3 s = parallel_reduce(
+        const Sum3 t = parallel_reduce(
             n, Sum3{},
             [&](std::size_t i) {
-              if (P.kind[i] == Kind::Wall) return Sum3{};
+              if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid) return Sum3{};
               const Vec3 p = P.m[i] * P.v[i];
               return Sum3{p, P.x[i].cross(p), 0.0};
             },
             [](const Sum3& a, const Sum3& b) { return a + b; });
+        // Rigid bodies: P and, about the origin, com x P plus the spin L (eq. 20).
+        Sum3 s = t;
+        for (const RigidBody& b : world.rigid_bodies()) s = s + Sum3{b.P, b.com.cross(b.P) + b.L, 0.0};
         for (int d = 0; d < 3; ++d) out.push_back(s.a[d]);
         for (int d = 0; d < 3; ++d) out.push_back(s.b[d]);
         break;

@@ -2,13 +2,16 @@
 // The scene (materials, parameters) is read-only after construction; step() only writes state.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
+#include "contact_dem.hpp"
 #include "fluid_wcsph.hpp"
 #include "kernel.hpp"
 #include "neighbors.hpp"
 #include "particles.hpp"
+#include "rigid_body.hpp"
 #include "scene.hpp"
 #include "snapshot.hpp"
 
@@ -16,16 +19,16 @@ namespace aortasph {
 
 // Wall time per phase of the step, summed over steps [s].
 struct Profile {
-  double neighbors = 0, density = 0, boundary = 0, forces = 0, integrate = 0, sort = 0;
-  double total() const { return neighbors + density + boundary + forces + integrate + sort; }
+  double neighbors = 0, density = 0, boundary = 0, forces = 0, rigid = 0, integrate = 0, sort = 0;
+  double total() const { return neighbors + density + boundary + forces + rigid + integrate + sort; }
   // (name, seconds) of each phase, in step order: the one list that diagnostics, run.json and bench print.
   std::vector<std::pair<std::string, double>> phases() const {
-    return {{"neighbors", neighbors}, {"density", density}, {"boundary", boundary},
-            {"forces", forces},       {"integrate", integrate}, {"sort", sort}};
+    return {{"neighbors", neighbors}, {"density", density}, {"boundary", boundary}, {"forces", forces},
+            {"rigid", rigid},         {"integrate", integrate}, {"sort", sort}};
   }
   Profile operator-(const Profile& o) const {
-    return {neighbors - o.neighbors, density - o.density, boundary - o.boundary,
-            forces - o.forces,       integrate - o.integrate, sort - o.sort};
+    return {neighbors - o.neighbors, density - o.density, boundary - o.boundary, forces - o.forces,
+            rigid - o.rigid,         integrate - o.integrate, sort - o.sort};
   }
 };
 
@@ -34,6 +37,7 @@ struct BodyInfo {
   MaterialType type = MaterialType::Fluid;
   int material = 0;
   std::size_t count = 0;   // particles at t = 0
+  int rigid = -1;          // index into World::rigid_bodies() for rigid bodies
   SurfaceMesh mesh;        // world coordinates at t = 0
 };
 
@@ -78,6 +82,7 @@ class World {
   const Particles& particles() const { return P_; }
   const NeighborSearch& neighbors() const { return nb_; }
   const std::vector<BodyInfo>& bodies() const { return bodies_; }
+  const std::vector<RigidBody>& rigid_bodies() const { return rigid_; }
   const CubicSpline& kernel() const { return kernel_; }
   const std::vector<FluidParams>& fluid_params() const { return fluid_; }
   const Profile& profile() const { return profile_; }
@@ -101,6 +106,7 @@ class World {
   void build_lists();
   std::vector<uint8_t> fixed_mask() const;  // 1 for particles that never move (walls)
   void integrate(double dt);
+  void step_rigid(double dt);
   void check_and_remove(double dt);
 
   Scene scene_;
@@ -112,6 +118,11 @@ class World {
   Particles P_;
   NeighborSearch nb_;
   std::vector<BodyInfo> bodies_;
+  std::vector<RigidBody> rigid_;
+  ContactParams contact_;
+  double min_contact_mass_ = std::numeric_limits<double>::max();
+  std::vector<Vec3> force_;   // per-particle force on body particles of the current step
+  std::vector<Vec3> moment_;  // and the moment of its contact forces about the particle (contact_dem.hpp)
   Profile profile_;
   double time_ = 0.0;
   long steps_ = 0;
