@@ -133,7 +133,10 @@ World::World(const Scene& scene)
       info.rigid = static_cast<int>(rigid_.size());
       rigid_.push_back(make_rigid_body(static_cast<int>(b), sample.points, mat.density * volume, dx, body.velocity,
                                        body.angular_velocity));
-      min_contact_mass_ = std::min(min_contact_mass_, mat.density * volume);
+      // A rigid body answers a contact with its whole mass M, and up to about n^(2/3) of its n particles (one
+      // face) can touch at once: the stiffest mode has mass M / n^(2/3) on one spring.
+      const double n = static_cast<double>(sample.points.size());
+      min_contact_mass_ = std::min(min_contact_mass_, rigid_.back().mass / std::cbrt(n * n));
     }
     bodies_.push_back(std::move(info));
   }
@@ -178,7 +181,8 @@ double World::stable_dt() const {
   if (max_c0_ > 0.0) dt = std::min(dt, scene_.cfl * h / (max_c0_ + max_speed_));
   // Viscous diffusion limit (Morris, Fox & Zhu 1997, eq. 18): dt <= 0.125 h^2 / nu.
   if (max_nu_ > 0.0) dt = std::min(dt, 0.125 * h * h / max_nu_);
-  // Contact spring: two particles of mass m on a spring k touch for about pi sqrt(m / 2k). cfl * 0.1 sqrt(m / k)
+  // Contact spring: two particles of mass m on a spring k touch for about pi sqrt(m / 2k) (m: see the
+  // constructor for bodies of many particles). cfl * 0.1 sqrt(m / k)
   // resolves a contact in about 90 steps at cfl 0.25; the damped restitution converges to first order in dt
   // and is then within 2 % of the spring-dashpot formula up to zeta = 0.5 (tests/test_rigid.cpp).
   if (!rigid_.empty() && contact_.k > 0.0)
