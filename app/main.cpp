@@ -8,7 +8,6 @@
 #include "commands.hpp"
 #include "errors.hpp"
 #include "sim_errors.hpp"
-#include "render_commands.hpp"
 
 namespace {
 
@@ -84,8 +83,7 @@ int dispatch(const std::vector<std::string>& args) {
     }
     return cmd_bench(threads, quick, json);
   }
-  if (cmd == "compare") return cmd_compare(rest);
-  if (cmd == "movie") return cmd_movie(rest);
+  if (cmd == "compare" || cmd == "movie") throw InputError(cmd + ": not available in this build yet (the renderer lands next)");
   throw InputError(cmd + ": unknown command (see aortasph --help)");
 }
 

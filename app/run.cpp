@@ -215,7 +215,6 @@ int cmd_run(const RunOptions& o) {
                       {"fluid", world.count(Kind::Fluid)},
                       {"boundary", world.particles().size() - world.count(Kind::Fluid)}};
     j["time"] = {{"simulated", world.time()}, {"steps", world.steps()}, {"frames", frame}};
-    const Profile& p = world.profile();
     j["timings_s"] = {{"setup", setup_seconds},
                       {"wall", std::chrono::duration<double>(Clock::now() - wall_start).count()}};
     for (const auto& [name, sec] : world.profile().phases()) j["timings_s"][name] = sec;
@@ -290,12 +289,14 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
   const double neighbors = n ? static_cast<double>(world.neighbors().pairs()) / static_cast<double>(n) : 0.0;
   std::printf("  dt estimate %.3g s (cfl %g, max_dt %g), about %.0f steps to t = %g s, %.0f neighbours/particle\n",
               dt, scene.cfl, scene.max_dt, steps, scene.t_end, neighbors);
-  // Cost model: about 1e6 particle-steps per second per core at ~70 neighbours (measured by aortasph bench);
-  // this is a first guess, the dt adapts during the run.
-  const double particle_steps = steps * static_cast<double>(n);
+  // Cost model: about 1e6 moving-particle-steps per second on 2 cores at ~80 neighbours (aortasph bench); fixed
+  // wall particles cost about a tenth of a moving one. A first guess: the dt adapts during the run.
+  const double moving = static_cast<double>(n - world.count(Kind::Wall));
+  const double walls = static_cast<double>(world.count(Kind::Wall));
+  const double particle_steps = steps * (moving + 0.1 * walls);
   const int threads = max_threads();
   std::printf("  cost estimate: %.3g particle-steps, about %s on %d thread(s); memory about %.0f MB\n",
-              particle_steps, hms(particle_steps / (1.0e6 * threads)).c_str(), threads,
+              particle_steps, hms(particle_steps / (0.5e6 * threads)).c_str(), threads,
               static_cast<double>(world.memory_bytes()) / 1e6);
   std::printf("  outputs: %ld (every %g s), probes: %zu, cameras: %zu\n",
               static_cast<long>(std::floor(scene.t_end / scene.output_interval + 1e-9)) + 1, scene.output_interval,

@@ -146,7 +146,7 @@ TEST_CASE("cli: an unstable run exits 3, names time and particle, keeps the rows
   // A time step forced 30 times beyond the acoustic CFL limit (time.fixed_dt bypasses the adaptive step).
   const fs::path scene = write_file(dir, "scene.json", replace(kGood, "\"end\": 0.002", "\"end\": 0.5"));
   const Result r = aortasph("run " + scene.string() + " --quiet --out " + (dir / "out").string() +
-                            " --set time.fixed_dt=0.01");
+                            " --set time.fixed_dt=0.01 --set time.output_interval=0.05");
   INFO(r.err);
   CHECK(r.code == 3);
   CHECK(r.err.find("unstable at t = ") != std::string::npos);

@@ -1,0 +1,556 @@
+#include "scene_loader.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "errors.hpp"
+
+namespace aortasph {
+
+namespace {
+
+using json = nlohmann::json;
+
+std::string type_name(const json& j) {
+  if (j.is_number()) return "a number";
+  if (j.is_string()) return "a string";
+  if (j.is_boolean()) return "a boolean";
+  if (j.is_array()) return "a list";
+  if (j.is_object()) return "an object";
+  return "null";
+}
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) { throw InputError(path + ": " + what); }
+
+std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+std::string index(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
+
+// Reads one JSON object: checks its type, that it has no unknown key (typos are errors), fills defaults into
+// the JSON (so the resolved scene in run.json is complete) and records the keys an object may have, for --set.
+class Obj {
+ public:
+  Obj(json& j, std::string path, std::vector<std::string> keys, std::map<std::string, std::set<std::string>>& allowed)
+      : j_(j), path_(std::move(path)) {
+    if (!j_.is_object()) fail(path_.empty() ? "scene" : path_, "expected an object, got " + type_name(j_));
+    for (auto it = j_.begin(); it != j_.end(); ++it)
+      if (std::find(keys.begin(), keys.end(), it.key()) == keys.end()) {
+        std::string list;
+        for (const auto& k : keys) list += (list.empty() ? "" : ", ") + k;
+        fail(join(path_, it.key()), "unknown key (allowed here: " + list + ")");
+      }
+    allowed[path_].insert(keys.begin(), keys.end());
+  }
+
+  const std::string& path() const { return path_; }
+  std::string path(const std::string& key) const { return join(path_, key); }
+  bool has(const std::string& key) const { return j_.contains(key); }
+  json& raw(const std::string& key) {
+    if (!j_.contains(key)) fail(path(key), "missing");
+    return j_[key];
+  }
+
+  double number(const std::string& key, std::optional<double> def = std::nullopt) {
+    if (!j_.contains(key)) {
+      if (!def) fail(path(key), "missing (expected a number)");
+      j_[key] = *def;
+    }
+    const json& v = j_[key];
+    if (!v.is_number()) fail(path(key), "expected a number, got " + type_name(v));
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) fail(path(key), "expected a finite number");
+    return d;
+  }
+  double positive(const std::string& key, std::optional<double> def = std::nullopt) {
+    const double d = number(key, def);
+    if (!(d > 0)) fail(path(key), "must be positive, got " + json(d).dump());
+    return d;
+  }
+  double non_negative(const std::string& key, std::optional<double> def = std::nullopt) {
+    const double d = number(key, def);
+    if (d < 0) fail(path(key), "must not be negative, got " + json(d).dump());
+    return d;
+  }
+  int integer(const std::string& key, std::optional<int> def, int lo, int hi) {
+    const double d = number(key, def ? std::optional<double>(*def) : std::nullopt);
+    if (d != std::floor(d) || d < lo || d > hi)
+      fail(path(key), "expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + json(d).dump());
+    return static_cast<int>(d);
+  }
+  bool boolean(const std::string& key, bool def) {
+    if (!j_.contains(key)) j_[key] = def;
+    if (!j_[key].is_boolean()) fail(path(key), "expected true or false, got " + type_name(j_[key]));
+    return j_[key].get<bool>();
+  }
+  std::string string(const std::string& key, std::optional<std::string> def = std::nullopt) {
+    if (!j_.contains(key)) {
+      if (!def) fail(path(key), "missing (expected a string)");
+      j_[key] = *def;
+    }
+    if (!j_[key].is_string()) fail(path(key), "expected a string, got " + type_name(j_[key]));
+    return j_[key].get<std::string>();
+  }
+  std::string choice(const std::string& key, std::vector<std::string> options, std::optional<std::string> def = std::nullopt) {
+    const std::string s = string(key, def);
+    if (std::find(options.begin(), options.end(), s) == options.end()) {
+      std::string list;
+      for (const auto& o : options) list += (list.empty() ? "" : ", ") + o;
+      fail(path(key), "unknown value '" + s + "' (expected one of: " + list + ")");
+    }
+    return s;
+  }
+  Vec3 vec3(const std::string& key, std::optional<Vec3> def = std::nullopt) {
+    if (!j_.contains(key)) {
+      if (!def) fail(path(key), "missing (expected 3 numbers)");
+      j_[key] = {def->x(), def->y(), def->z()};
+    }
+    const json& v = j_[key];
+    if (!v.is_array()) fail(path(key), "expected 3 numbers, got " + type_name(v));
+    if (v.size() != 3) fail(path(key), "expected 3 numbers, got " + std::to_string(v.size()));
+    Vec3 out;
+    for (int d = 0; d < 3; ++d) {
+      if (!v[d].is_number()) fail(index(path(key), d), "expected a number, got " + type_name(v[d]));
+      out[d] = v[d].get<double>();
+      if (!std::isfinite(out[d])) fail(index(path(key), d), "expected a finite number");
+    }
+    return out;
+  }
+  Vec3 unit(const std::string& key, std::optional<Vec3> def = std::nullopt) {
+    const Vec3 v = vec3(key, def);
+    if (v.norm() < 1e-12) fail(path(key), "must not be the zero vector");
+    return v.normalized();
+  }
+  Vec3 color(const std::string& key) {
+    const Vec3 c = vec3(key);
+    for (int d = 0; d < 3; ++d)
+      if (c[d] < 0 || c[d] > 1) fail(index(path(key), d), "colour components must lie in 0..1");
+    return c;
+  }
+  Box box(const std::string& lo_key = "min", const std::string& hi_key = "max") {
+    Box b{vec3(lo_key), vec3(hi_key)};
+    for (int d = 0; d < 3; ++d)
+      if (!(b.min[d] < b.max[d]))
+        fail(path(hi_key), "must be greater than " + lo_key + " in every component (component " + std::to_string(d) + ")");
+    return b;
+  }
+  std::vector<std::string> strings(const std::string& key, std::optional<std::vector<std::string>> def = std::nullopt) {
+    if (!j_.contains(key)) {
+      if (!def) fail(path(key), "missing (expected a list of strings)");
+      j_[key] = *def;
+    }
+    const json& v = j_[key];
+    if (!v.is_array()) fail(path(key), "expected a list of strings, got " + type_name(v));
+    std::vector<std::string> out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      if (!v[i].is_string()) fail(index(path(key), i), "expected a string, got " + type_name(v[i]));
+      out.push_back(v[i].get<std::string>());
+    }
+    return out;
+  }
+
+ private:
+  json& j_;
+  std::string path_;
+};
+
+class Loader {
+ public:
+  std::map<std::string, std::set<std::string>> allowed;
+
+  Scene load(json& root) {
+    Scene s;
+    Obj top(root, "", {"name", "description", "domain", "resolution", "time", "gravity", "materials", "contact", "bodies", "probes", "render"}, allowed);
+    s.name = top.string("name");
+    if (s.name.empty() || s.name.find('/') != std::string::npos || s.name == "." || s.name == "..")
+      fail("name", "must be a non-empty name without '/'");
+    if (top.has("description")) top.string("description");
+
+    Obj dom(top.raw("domain"), "domain", {"min", "max", "max_leave_fraction"}, allowed);
+    s.domain = dom.box();
+    s.max_leave_fraction = dom.non_negative("max_leave_fraction", 0.0);
+    if (s.max_leave_fraction > 1) fail(dom.path("max_leave_fraction"), "must lie in 0..1");
+
+    Obj res(top.raw("resolution"), "resolution", {"spacing", "smoothing_ratio"}, allowed);
+    s.spacing = res.positive("spacing");
+    s.smoothing_ratio = res.number("smoothing_ratio", 1.3);
+    if (s.smoothing_ratio < 1.0 || s.smoothing_ratio > 3.0) fail(res.path("smoothing_ratio"), "must lie in 1..3");
+
+    Obj time(top.raw("time"), "time", {"end", "output_interval", "cfl", "max_dt", "max_speed", "fixed_dt"}, allowed);
+    s.t_end = time.positive("end");
+    s.output_interval = time.positive("output_interval");
+    s.cfl = time.positive("cfl", 0.25);
+    if (s.cfl > 1) fail(time.path("cfl"), "must lie in (0, 1]");
+    s.max_dt = time.positive("max_dt", 1e-3);
+    s.max_speed = time.non_negative("max_speed", 0.0);
+    s.fixed_dt = time.non_negative("fixed_dt", 0.0);
+    if (s.t_end / s.output_interval > 1e6) fail(time.path("output_interval"), "more than a million outputs");
+
+    if (!top.has("gravity")) root["gravity"] = {0.0, -9.81, 0.0};
+    s.gravity = top.vec3("gravity");
+
+    materials(top.raw("materials"), s);
+    if (!top.has("contact")) root["contact"] = json::object();
+    Obj con(top.raw("contact"), "contact", {"stiffness", "damping", "shear", "friction"}, allowed);
+    s.contact.stiffness = con.non_negative("stiffness", 0.0);
+    s.contact.damping = con.non_negative("damping", 0.0);
+    s.contact.shear = con.non_negative("shear", 0.0);
+    s.contact.friction = con.non_negative("friction", 0.5);
+
+    json& bodies = top.raw("bodies");
+    if (!bodies.is_array() || bodies.empty()) fail("bodies", "expected a non-empty list of bodies");
+    for (std::size_t b = 0; b < bodies.size(); ++b) s.bodies.push_back(body(bodies[b], index("bodies", b), s));
+    for (std::size_t b = 0; b < s.bodies.size(); ++b)
+      for (std::size_t c = 0; c < b; ++c)
+        if (s.bodies[b].name == s.bodies[c].name) fail(index("bodies", b) + ".name", "duplicate body name '" + s.bodies[b].name + "'");
+    if (s.bodies.size() > 60000) fail("bodies", "too many bodies");
+
+    if (!top.has("probes")) root["probes"] = json::array();
+    json& probes = top.raw("probes");
+    if (!probes.is_array()) fail("probes", "expected a list, got " + type_name(probes));
+    for (std::size_t p = 0; p < probes.size(); ++p) {
+      s.probes.push_back(probe(probes[p], index("probes", p), s));
+      for (std::size_t q = 0; q < p; ++q)
+        if (s.probes[q].name == s.probes[p].name) fail(index("probes", p) + ".name", "duplicate probe name '" + s.probes[p].name + "'");
+    }
+    if (top.has("render")) render(top.raw("render"), s);
+    return s;
+  }
+
+ private:
+  void materials(json& j, Scene& s) {
+    if (!j.is_object() || j.empty()) fail("materials", "expected an object of named materials");
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      const std::string path = "materials." + it.key();
+      if (!it.value().is_object()) fail(path, "expected an object, got " + type_name(it.value()));
+      const std::string type = it.value().contains("type") && it.value()["type"].is_string() ? it.value()["type"].get<std::string>() : "";
+      Material m;
+      m.name = it.key();
+      std::vector<std::string> keys = {"type"};
+      if (type == "fluid") keys = {"type", "density", "viscosity", "sound_speed", "eos_exponent", "delta_sph", "artificial_viscosity", "density_summation", "background_pressure"};
+      else if (type == "elastic") keys = {"type", "density", "youngs_modulus", "poisson_ratio", "hourglass", "artificial_viscosity"};
+      else if (type == "rigid") keys = {"type", "density"};
+      Obj o(it.value(), path, keys, allowed);
+      o.choice("type", {"fluid", "elastic", "rigid", "wall"});
+      if (type == "fluid") {
+        m.type = MaterialType::Fluid;
+        m.density = o.positive("density");
+        m.viscosity = o.non_negative("viscosity");
+        m.sound_speed = o.positive("sound_speed");
+        m.eos_exponent = o.positive("eos_exponent", 7.0);
+        m.delta_sph = o.non_negative("delta_sph", 0.1);
+        m.artificial_viscosity = o.non_negative("artificial_viscosity", 0.0);
+        m.density_summation = o.boolean("density_summation", false);
+        m.background_pressure = o.number("background_pressure", 0.0);
+      } else if (type == "elastic") {
+        m.type = MaterialType::Elastic;
+        m.density = o.positive("density");
+        m.youngs_modulus = o.positive("youngs_modulus");
+        m.poisson_ratio = o.number("poisson_ratio");
+        if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5))
+          fail(o.path("poisson_ratio"), "must lie in (-1, 0.5), got " + json(m.poisson_ratio).dump());
+        m.hourglass = o.non_negative("hourglass", 10.0);
+        m.solid_art_viscosity = o.non_negative("artificial_viscosity", 1.0);
+      } else if (type == "rigid") {
+        m.type = MaterialType::Rigid;
+        m.density = o.positive("density");
+      } else {
+        m.type = MaterialType::Wall;
+      }
+      s.materials.push_back(m);
+    }
+  }
+
+  int material_index(const Scene& s, const std::string& name, const std::string& path) {
+    for (std::size_t m = 0; m < s.materials.size(); ++m)
+      if (s.materials[m].name == name) return static_cast<int>(m);
+    fail(path, "unknown material '" + name + "'");
+  }
+
+  int body_index(const Scene& s, const std::string& name, const std::string& path) {
+    for (std::size_t b = 0; b < s.bodies.size(); ++b)
+      if (s.bodies[b].name == name) return static_cast<int>(b);
+    fail(path, "unknown body '" + name + "'");
+  }
+
+  Body body(json& j, const std::string& path, const Scene& s) {
+    Obj o(j, path, {"name", "material", "shape", "translate", "rotate", "velocity", "angular_velocity", "color", "render", "fixed"}, allowed);
+    Body b;
+    b.name = o.string("name");
+    if (b.name.empty()) fail(o.path("name"), "must not be empty");
+    b.material = material_index(s, o.string("material"), o.path("material"));
+    b.shape = shape(o.raw("shape"), o.path("shape"), s.spacing);
+    b.translate = o.vec3("translate", Vec3::Zero());
+    if (o.has("rotate")) {
+      Obj r(o.raw("rotate"), o.path("rotate"), {"axis", "degrees"}, allowed);
+      b.rotate_axis = r.unit("axis");
+      b.rotate_degrees = r.number("degrees");
+    }
+    b.velocity = o.vec3("velocity", Vec3::Zero());
+    b.angular_velocity = o.vec3("angular_velocity", Vec3::Zero());
+    if (o.has("color")) b.color = o.color("color");
+    const std::string mode = o.choice("render", {"particles", "surface", "hidden"}, "particles");
+    b.render = mode == "surface" ? RenderMode::Surface : mode == "hidden" ? RenderMode::Hidden : RenderMode::Particles;
+    if (o.has("fixed")) {
+      json& f = o.raw("fixed");
+      if (f.is_object() && f.contains("box")) {
+        Obj fo(f, o.path("fixed"), {"box"}, allowed);
+        Obj bo(fo.raw("box"), fo.path("box"), {"min", "max"}, allowed);
+        b.fixed = bo.box();
+      } else {
+        Obj fo(f, o.path("fixed"), {"min", "max"}, allowed);
+        b.fixed = fo.box();
+      }
+      if (s.materials[b.material].type != MaterialType::Elastic)
+        fail(o.path("fixed"), "only elastic bodies can have a fixed region");
+    }
+    return b;
+  }
+
+  Shape shape(json& j, const std::string& path, double dx) {
+    static const std::vector<std::string> kinds = {"box", "sphere", "cylinder", "container", "tube", "aortic_root", "mesh"};
+    Obj o(j, path, kinds, allowed);
+    if (j.size() != 1) fail(path, "expected exactly one shape (one of box, sphere, cylinder, container, tube), got " + std::to_string(j.size()));
+    const std::string kind = j.begin().key();
+    Shape sh;
+    const std::string p = o.path(kind);
+    if (kind == "box") {
+      Obj b(o.raw(kind), p, {"min", "max"}, allowed);
+      sh.kind = ShapeKind::Box;
+      sh.box = b.box();
+    } else if (kind == "sphere") {
+      Obj b(o.raw(kind), p, {"center", "radius"}, allowed);
+      sh.kind = ShapeKind::Sphere;
+      sh.center = b.vec3("center");
+      sh.radius = b.positive("radius");
+    } else if (kind == "cylinder" || kind == "tube") {
+      const bool tube = kind == "tube";
+      Obj b(o.raw(kind), p, tube ? std::vector<std::string>{"base", "axis", "radius", "length", "layers"}
+                                 : std::vector<std::string>{"base", "axis", "radius", "length"}, allowed);
+      sh.kind = tube ? ShapeKind::Tube : ShapeKind::Cylinder;
+      sh.base = b.vec3("base");
+      sh.axis = b.unit("axis");
+      sh.radius = b.positive("radius");
+      sh.length = b.positive("length");
+      if (tube) sh.layers = b.integer("layers", 3, 1, 20);
+    } else if (kind == "container") {
+      Obj b(o.raw(kind), p, {"min", "max", "layers", "open"}, allowed);
+      sh.kind = ShapeKind::Container;
+      sh.box = b.box();
+      sh.layers = b.integer("layers", 3, 1, 20);
+      sh.open = b.strings("open", std::vector<std::string>{});
+      for (std::size_t k = 0; k < sh.open.size(); ++k) {
+        static const std::set<std::string> faces = {"+x", "-x", "+y", "-y", "+z", "-z"};
+        if (!faces.count(sh.open[k])) fail(index(b.path("open"), k), "unknown face '" + sh.open[k] + "' (expected +x, -x, +y, -y, +z or -z)");
+      }
+    } else {
+      fail(p, "shape '" + kind + "' is not supported yet");
+    }
+    // A lattice of more than about 200 million points would exhaust memory long before it ran.
+    Vec3 extent = Vec3::Zero();
+    if (sh.kind == ShapeKind::Box || sh.kind == ShapeKind::Container) extent = sh.box.max - sh.box.min + Vec3::Constant(2 * sh.layers * dx);
+    else extent = Vec3::Constant(2 * (sh.radius + sh.layers * dx) + sh.length);
+    const double cells = (extent / dx).array().ceil().prod();
+    if (cells > 2e8) fail(p, "holds about " + json(cells).dump() + " lattice points at spacing " + json(dx).dump() + ": too many particles");
+    return sh;
+  }
+
+  Probe probe(json& j, const std::string& path, const Scene& s) {
+    if (!j.is_object()) fail(path, "expected an object, got " + type_name(j));
+    const std::string type = j.contains("type") && j["type"].is_string() ? j["type"].get<std::string>() : "";
+    std::vector<std::string> keys = {"name", "type"};
+    if (type == "extent") keys.insert(keys.end(), {"bodies", "axis", "stat", "region"});
+    if (type == "pressure") keys.insert(keys.end(), {"point"});
+    if (type == "body") keys.insert(keys.end(), {"body"});
+    if (type == "point") keys.insert(keys.end(), {"body", "reference"});
+    if (type == "flow_rate") keys.insert(keys.end(), {"point", "normal", "radius"});
+    if (type == "orifice_area") keys.insert(keys.end(), {"body", "point", "normal"});
+    Obj o(j, path, keys, allowed);
+    Probe p;
+    p.name = o.string("name");
+    if (p.name.empty() || p.name.find_first_of(",\"\n") != std::string::npos) fail(o.path("name"), "must be a non-empty name without commas or quotes");
+    o.choice("type", {"extent", "pressure", "body", "point", "energy", "momentum", "flow_rate", "orifice_area"});
+    if (type == "extent") {
+      p.type = ProbeType::Extent;
+      const auto names = o.strings("bodies");
+      if (names.empty()) fail(o.path("bodies"), "expected at least one body");
+      for (std::size_t k = 0; k < names.size(); ++k) p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
+      const std::string axis = o.choice("axis", {"x", "y", "z"});
+      p.axis = axis[0] - 'x';
+      p.stat_max = o.choice("stat", {"max", "min"}) == "max";
+      if (o.has("region")) {
+        Obj r(o.raw("region"), o.path("region"), {"min", "max"}, allowed);
+        p.region = r.box();
+      }
+    } else if (type == "pressure") {
+      p.type = ProbeType::Pressure;
+      p.point = o.vec3("point");
+    } else if (type == "body") {
+      p.type = ProbeType::BodyState;
+      p.body = body_index(s, o.string("body"), o.path("body"));
+    } else if (type == "point") {
+      p.type = ProbeType::Point;
+      p.body = body_index(s, o.string("body"), o.path("body"));
+      p.reference = o.vec3("reference");
+    } else if (type == "energy") {
+      p.type = ProbeType::Energy;
+    } else if (type == "momentum") {
+      p.type = ProbeType::Momentum;
+    } else if (type == "flow_rate") {
+      p.type = ProbeType::FlowRate;
+      p.point = o.vec3("point");
+      p.normal = o.unit("normal");
+      p.radius = o.positive("radius");
+    } else {
+      p.type = ProbeType::OrificeArea;
+      p.body = body_index(s, o.string("body"), o.path("body"));
+      p.point = o.vec3("point");
+      p.normal = o.unit("normal");
+    }
+    return p;
+  }
+
+  void render(json& j, Scene& s) {
+    Obj o(j, "render", {"width", "height", "background", "color_by", "colormap", "range", "cameras", "clip", "figures"}, allowed);
+    RenderSettings& r = s.render;
+    r.width = o.integer("width", 1280, 2, 16384);
+    r.height = o.integer("height", 720, 2, 16384);
+    if (r.width % 2 || r.height % 2) fail(o.path(r.width % 2 ? "width" : "height"), "must be even (movies need even sizes)");
+    if (!o.has("background")) j["background"] = {1.0, 1.0, 1.0};
+    r.background = o.color("background");
+    r.color_by = o.choice("color_by", {"material", "speed", "pressure", "displacement", "stress"}, "material");
+    r.colormap = o.string("colormap", "viridis");
+    if (o.has("range")) {
+      const json& v = o.raw("range");
+      if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
+        fail(o.path("range"), "expected two numbers [low, high]");
+      r.range = std::pair{v[0].get<double>(), v[1].get<double>()};
+      if (!(r.range->first < r.range->second)) fail(o.path("range"), "low must be below high");
+    }
+    if (!o.has("cameras")) j["cameras"] = json::array();
+    json& cams = o.raw("cameras");
+    if (!cams.is_array()) fail(o.path("cameras"), "expected a list, got " + type_name(cams));
+    for (std::size_t c = 0; c < cams.size(); ++c) {
+      Obj co(cams[c], index("render.cameras", c), {"name", "eye", "target", "up", "fov_deg"}, allowed);
+      Camera cam;
+      cam.name = co.string("name");
+      if (cam.name.empty() || cam.name.find('/') != std::string::npos) fail(co.path("name"), "must be a non-empty name without '/'");
+      for (const Camera& other : r.cameras)
+        if (other.name == cam.name) fail(co.path("name"), "duplicate camera name '" + cam.name + "'");
+      cam.eye = co.vec3("eye");
+      cam.target = co.vec3("target");
+      cam.up = co.unit("up", Vec3::UnitY());
+      cam.fov_deg = co.number("fov_deg", 35.0);
+      if (cam.fov_deg <= 1 || cam.fov_deg >= 179) fail(co.path("fov_deg"), "must lie in (1, 179) degrees");
+      if ((cam.eye - cam.target).norm() < 1e-12) fail(co.path("target"), "must differ from eye");
+      if ((cam.eye - cam.target).normalized().cross(cam.up).norm() < 1e-6) fail(co.path("up"), "is parallel to the viewing direction");
+      r.cameras.push_back(cam);
+    }
+    if (o.has("clip")) {
+      Obj co(o.raw("clip"), "render.clip", {"point", "normal", "bodies"}, allowed);
+      Clip clip;
+      clip.point = co.vec3("point");
+      clip.normal = co.unit("normal");
+      const auto names = co.strings("bodies", std::vector<std::string>{});
+      for (std::size_t k = 0; k < names.size(); ++k) clip.bodies.push_back(body_index(s, names[k], index(co.path("bodies"), k)));
+      r.clip = clip;
+    }
+    if (!o.has("figures")) j["figures"] = json::array();
+    json& figs = o.raw("figures");
+    if (!figs.is_array()) fail(o.path("figures"), "expected a list, got " + type_name(figs));
+    for (std::size_t f = 0; f < figs.size(); ++f) {
+      Obj fo(figs[f], index("render.figures", f), {"name", "camera", "times", "columns"}, allowed);
+      Figure fig;
+      fig.name = fo.string("name");
+      if (fig.name.empty() || fig.name.find('/') != std::string::npos) fail(fo.path("name"), "must be a non-empty name without '/'");
+      fig.camera = fo.string("camera");
+      if (std::none_of(r.cameras.begin(), r.cameras.end(), [&](const Camera& c) { return c.name == fig.camera; }))
+        fail(fo.path("camera"), "unknown camera '" + fig.camera + "'");
+      const json& t = fo.raw("times");
+      if (!t.is_array() || t.empty()) fail(fo.path("times"), "expected a non-empty list of times");
+      for (std::size_t k = 0; k < t.size(); ++k) {
+        if (!t[k].is_number()) fail(index(fo.path("times"), k), "expected a number, got " + type_name(t[k]));
+        const double v = t[k].get<double>();
+        if (v < 0 || v > s.t_end + 1e-12) fail(index(fo.path("times"), k), "must lie in 0..time.end");
+        fig.times.push_back(v);
+      }
+      fig.columns = fo.integer("columns", 3, 1, 64);
+      r.figures.push_back(fig);
+    }
+  }
+};
+
+// Applies one --set KEY=VALUE to the JSON. A key may be new only where the loader allows it (an optional key).
+void apply_override(json& root, const std::string& item, const std::map<std::string, std::set<std::string>>& allowed) {
+  const auto eq = item.find('=');
+  if (eq == std::string::npos || eq == 0) throw InputError("--set " + item + ": expected KEY=VALUE");
+  const std::string key = item.substr(0, eq), text = item.substr(eq + 1);
+  json value = json::parse(text, nullptr, false);
+  if (value.is_discarded()) value = text;  // not JSON: a plain string
+
+  std::vector<std::string> parts;
+  std::stringstream ss(key);
+  for (std::string part; std::getline(ss, part, '.');) parts.push_back(part);
+  json* node = &root;
+  std::string path;  // in the loader's notation: a.b[2].c
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const std::string& part = parts[k];
+    const bool last = k + 1 == parts.size();
+    if (node->is_array()) {
+      std::size_t i = 0;
+      try {
+        std::size_t used = 0;
+        i = std::stoul(part, &used);
+        if (used != part.size()) throw std::invalid_argument("");
+      } catch (const std::exception&) {
+        throw InputError("--set " + item + ": '" + part + "' is not a list index (at '" + path + "')");
+      }
+      if (i >= node->size())
+        throw InputError("--set " + item + ": index " + part + " out of range ('" + path + "' has " + std::to_string(node->size()) + " entries)");
+      path = index(path, i);
+      node = &(*node)[i];
+    } else if (node->is_object()) {
+      const std::string here = path;
+      path = join(path, part);
+      if (!node->contains(part)) {
+        const auto it = allowed.find(here);
+        const bool known = it != allowed.end() && it->second.count(part);
+        if (!known || !last) throw InputError("--set " + item + ": unknown path '" + key + "' (no '" + part + "' at '" + (here.empty() ? "scene" : here) + "')");
+      }
+      node = &(*node)[part];
+    } else {
+      throw InputError("--set " + item + ": unknown path '" + key + "' ('" + path + "' is a value, not an object or list)");
+    }
+  }
+  *node = value;
+}
+
+}  // namespace
+
+LoadedScene load_scene_json(const nlohmann::json& j, const std::vector<std::string>& overrides, const std::filesystem::path&) {
+  // First pass: validate the file as written, fill in defaults, learn which optional keys each object allows.
+  json filled = j;
+  Loader first;
+  Scene scene = first.load(filled);
+  if (overrides.empty()) return {scene, filled};
+  // Then apply --set to the filled JSON and validate again.
+  for (const auto& o : overrides) apply_override(filled, o, first.allowed);
+  return {Loader{}.load(filled), filled};
+}
+
+LoadedScene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file.string() + ": no such scene file");
+  std::ifstream f(file);
+  if (!f) throw InputError(file.string() + ": cannot read");
+  json j;
+  try {
+    j = json::parse(f);
+  } catch (const json::parse_error& e) {
+    throw InputError(file.string() + ": not valid JSON: " + e.what());
+  }
+  return load_scene_json(j, overrides, file.parent_path());
+}
+
+}  // namespace aortasph

@@ -1,0 +1,25 @@
+// Scene files (SPEC.md section 2): JSON -> validated Scene. Every error names the JSON path of the value at fault
+// ("bodies[2].shape.box.max: expected 3 numbers, got 2") and is thrown as InputError (exit code 2) before
+// anything is simulated.
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "scene.hpp"
+
+namespace aortasph {
+
+struct LoadedScene {
+  Scene scene;
+  nlohmann::json resolved;  // the JSON after --set overrides, every default filled in (written to run.json)
+};
+
+// overrides: "KEY=VALUE" strings from --set (dotted path with list indices; VALUE is JSON, or else a string).
+LoadedScene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides);
+LoadedScene load_scene_json(const nlohmann::json& j, const std::vector<std::string>& overrides,
+                            const std::filesystem::path& base_dir = {});
+
+}  // namespace aortasph

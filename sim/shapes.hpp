@@ -1,0 +1,26 @@
+// Particle sampling of the scene's shapes on a cubic lattice of the particle spacing (SPEC.md section 2), and
+// the surface meshes that the renderer draws for walls.
+#pragma once
+
+#include <vector>
+
+#include "scene.hpp"
+#include "snapshot.hpp"
+
+namespace aortasph {
+
+struct ShapeSample {
+  std::vector<Vec3> points;  // particle centres, world coordinates, lexicographic lattice order
+  SurfaceMesh mesh;          // surface for rendering, world coordinates
+};
+
+// Lattice convention: a box [min, max] holds the centres min + (i + 1/2) dx, so the particles' cubes tile it
+// exactly. Curved shapes keep the lattice points inside them. Container and tube walls lie outside their inner
+// surface, `layers` particles thick. The body's rotation (about the shape's centre) and translation are applied
+// last.
+ShapeSample sample_body(const Body& body, double spacing);
+
+// Centre about which a shape rotates: the centre of its bounding box before rotation.
+Vec3 shape_center(const Shape& shape);
+
+}  // namespace aortasph
