@@ -40,6 +40,9 @@ Scene bench_scene(bool quick) {
   column.material = 0;
   column.shape.kind = ShapeKind::Box;
   column.shape.box = {Vec3(0, 0, 0), Vec3(0.2, 0.4, depth)};
+  // The column starts at the speed of a developed surge front (1.5 m/s), so the neighbour lists are rebuilt
+  // as often as in the flowing dam break; from rest they would hardly be rebuilt during the measured steps.
+  column.velocity = Vec3(1.5, 0, 0);
   Body tank;
   tank.name = "tank";
   tank.material = 1;
@@ -66,6 +69,7 @@ int cmd_bench(int threads, bool quick, const std::filesystem::path& json_out) {
   const double dt = world.stable_dt();
   for (int k = 0; k < warmup; ++k) world.step(dt);
   const Profile before = world.profile();
+  const long builds_before = world.list_builds();
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < steps; ++k) world.step(world.stable_dt());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -78,7 +82,8 @@ int cmd_bench(int threads, bool quick, const std::filesystem::path& json_out) {
   std::printf("  particles          %10.0f fluid, %.0f boundary\n", fluid, total - fluid);
   std::printf("  steps              %10d (after %d warm-up), %.3f s wall\n", steps, warmup, wall);
   std::printf("  fluid particle-steps/s %10.3g\n", rate);
-  std::printf("  neighbours/particle %9.1f\n", neighbours);
+  std::printf("  neighbours/particle %9.1f (lists include a skin of 10 %% of the support)\n", neighbours);
+  std::printf("  list rebuilds      %10ld in %d steps\n", world.list_builds() - builds_before, steps);
   std::printf("  bytes/fluid particle %8.0f\n", bytes);
   std::printf("  phase        seconds   share\n");
   for (const auto& [name, sec] : p.phases())
@@ -93,6 +98,7 @@ int cmd_bench(int threads, bool quick, const std::filesystem::path& json_out) {
   j["wall_s"] = wall;
   j["fluid_particle_steps_per_s"] = rate;
   j["neighbours_per_particle"] = neighbours;
+  j["list_rebuilds"] = world.list_builds() - builds_before;
   j["bytes_per_fluid_particle"] = bytes;
   for (const auto& [name, sec] : p.phases()) j["phases_s"][name] = sec;
   std::ofstream f(json_out, std::ios::trunc);

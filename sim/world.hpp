@@ -89,6 +89,7 @@ class World {
   double time() const { return time_; }
   long steps() const { return steps_; }
   double last_dt() const { return last_dt_; }
+  long list_builds() const { return builds_; }
   double max_speed() const { return max_speed_; }
   double speed_limit() const { return speed_limit_; }
   std::size_t count(Kind k) const;
