@@ -225,6 +225,9 @@ class Loader {
       const std::string path = "materials." + it.key();
       if (!it.value().is_object()) fail(path, "expected an object, got " + type_name(it.value()));
       const std::string type = it.value().contains("type") && it.value()["type"].is_string() ? it.value()["type"].get<std::string>() : "";
+      if (!it.value().contains("type")) fail(path + ".type", "missing (expected fluid, elastic, rigid or wall)");
+      if (type != "fluid" && type != "elastic" && type != "rigid" && type != "wall")
+        fail(path + ".type", "unknown value " + it.value()["type"].dump() + " (expected one of: fluid, elastic, rigid, wall)");
       Material m;
       m.name = it.key();
       std::vector<std::string> keys = {"type"};

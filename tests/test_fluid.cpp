@@ -93,7 +93,7 @@ TEST_CASE("a fluid run is bitwise identical for 1 and 2 threads", "[fluid][deter
   CHECK(hashes[0] == hashes[1]);
 }
 
-TEST_CASE("a water column at rest: hydrostatic pressure, no leak, flat surface", "[fluid][hydrostatic]") {
+TEST_CASE("a water column at rest: hydrostatic pressure, no leak, flat surface", "[fluid][hydrostatic][validation]") {
   const double dx = 0.01, H = 0.2;
   Scene s;
   s.name = "hydrostatic_test";

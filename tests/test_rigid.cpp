@@ -81,7 +81,7 @@ TEST_CASE("inertia of a particle box and a particle sphere match the solids", "[
   CHECK(sphere.size() * dx * dx * dx == Approx(4.0 / 3.0 * std::numbers::pi * R * R * R).epsilon(0.05));
 }
 
-TEST_CASE("torque-free rotation keeps |L| and energy; a tilted spin precesses", "[rigid]") {
+TEST_CASE("torque-free rotation keeps |L| and energy, a tilted spin precesses", "[rigid]") {
   std::vector<Vec3> box;
   for (int i = 0; i < 10; ++i)
     for (int j = 0; j < 6; ++j)
