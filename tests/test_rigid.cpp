@@ -9,6 +9,7 @@
 #include "parallel.hpp"
 #include "probes.hpp"
 #include "rigid_body.hpp"
+#include "sim_errors.hpp"
 #include "world.hpp"
 
 using namespace aortasph;
@@ -306,5 +307,19 @@ TEST_CASE("a dense block sinks, a light one floats, no fluid passes through", "[
       if (std::abs(local.x()) < 0.02 && std::abs(local.y()) < 0.02 && std::abs(local.z()) < 0.01) ++inside;
     }
     CHECK(inside == 0);
+  }
+}
+
+TEST_CASE("bad rigid input: an empty body is refused naming it", "[rigid][bad-input]") {
+  Scene s = fluid_cubes(0.01);
+  s.materials.push_back(steel(3000));
+  // Thinner than half a spacing: no lattice point inside.
+  s.bodies.push_back(box_body("sliver", 1, Vec3(0.3, 0.3, 0.3), Vec3(0.304, 0.4, 0.4)));
+  try {
+    World w(s);
+    FAIL("an empty rigid body was accepted");
+  } catch (const SetupError& e) {
+    CHECK(std::string(e.what()).find("sliver") != std::string::npos);
+    CHECK(std::string(e.what()).find("no particle") != std::string::npos);
   }
 }
