@@ -4,12 +4,14 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
 #include "errors.hpp"
 #include "parallel.hpp"
+#include "render_bench.hpp"
 #include "world.hpp"
 
 namespace aortasph {
@@ -56,7 +58,7 @@ Scene bench_scene(bool quick) {
 
 }  // namespace
 
-int cmd_bench(int threads, bool quick, const std::filesystem::path& json_out) {
+int cmd_bench(int threads, bool quick, bool render, const std::filesystem::path& json_out) {
   if (threads > 0) set_threads(threads);
   const int used_threads = max_threads();
   const Scene scene = bench_scene(quick);
@@ -101,6 +103,13 @@ int cmd_bench(int threads, bool quick, const std::filesystem::path& json_out) {
   j["list_rebuilds"] = world.list_builds() - builds_before;
   j["bytes_per_fluid_particle"] = bytes;
   for (const auto& [name, sec] : p.phases()) j["phases_s"][name] = sec;
+  if (render) {
+    // Render speed at 1920x1080: drawing and PNG encoding timed separately (render/render_bench).
+    for (const int particles : quick ? std::vector<int>{100000} : std::vector<int>{100000, 1000000}) {
+      const RenderBenchResult r = bench_render(std::cout, particles);
+      j["render"][std::to_string(particles)] = {{"draw_ms", r.draw_ms}, {"png_ms", r.png_ms}};
+    }
+  }
   std::ofstream f(json_out, std::ios::trunc);
   if (!f) throw InputError(json_out.string() + ": cannot write");
   f << std::setw(2) << j << '\n';

@@ -21,7 +21,7 @@ struct RunOptions {
 
 int cmd_run(const RunOptions& options);
 int cmd_check(const std::filesystem::path& scene, const std::vector<std::string>& sets);
-int cmd_bench(int threads, bool quick, const std::filesystem::path& json_out);
+int cmd_bench(int threads, bool quick, bool render, const std::filesystem::path& json_out);
 
 // Parses the arguments after the subcommand word (throws InputError on bad arguments).
 RunOptions parse_run_options(const std::vector<std::string>& args);

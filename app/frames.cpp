@@ -1,8 +1,56 @@
 #include "frames.hpp"
 
+#include "errors.hpp"
+#include "pipeline.hpp"
+
 namespace aortasph {
 
-// Until the renderer lands, runs write no frames.
-std::unique_ptr<FrameSink> make_frame_sink(const Scene&, const std::filesystem::path&) { return nullptr; }
+namespace {
+
+class PipelineSink : public FrameSink {
+ public:
+  PipelineSink(const Scene& scene, const std::filesystem::path& out_dir)
+      : field_(scene.render.color_by), pipeline_(scene.render, out_dir, scene.output_interval) {}
+
+  // The snapshot is copied here, on the simulation thread; drawing and PNG encoding happen on the render thread.
+  void push(const World& world, int frame) override {
+    if (pipeline_.failed()) throw InputError("rendering failed: " + pipeline_.error());
+    try {
+      pipeline_.push(world.snapshot(field_, frame));
+    } catch (const RenderError& e) {
+      throw InputError(std::string("rendering failed: ") + e.what());
+    }
+  }
+  void finish() override {
+    try {
+      pipeline_.finish();
+    } catch (const std::exception& e) {
+      throw InputError(std::string("rendering failed: ") + e.what());
+    }
+    if (pipeline_.failed()) throw InputError("rendering failed: " + pipeline_.error());
+  }
+  void finish_quietly() override {
+    try {
+      pipeline_.finish();
+    } catch (const std::exception&) {
+      // A failed run's frames so far are on disk; the render error is secondary to the run's own.
+    }
+  }
+
+ private:
+  std::string field_;
+  FramePipeline pipeline_;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSink> make_frame_sink(const Scene& scene, const std::filesystem::path& out_dir) {
+  if (scene.render.cameras.empty()) return nullptr;
+  try {
+    return std::make_unique<PipelineSink>(scene, out_dir);
+  } catch (const std::exception& e) {
+    throw InputError(std::string("render: ") + e.what());
+  }
+}
 
 }  // namespace aortasph

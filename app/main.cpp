@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "errors.hpp"
+#include "render_commands.hpp"
 #include "sim_errors.hpp"
 
 namespace {
@@ -21,7 +22,7 @@ const char* kUsage =
     "  aortasph check SCENE.json [--set KEY=VALUE]...   validate and print bodies, counts, h, dt, cost\n"
     "  aortasph compare A B [--diff DIFF.png] [--tolerance T]\n"
     "  aortasph movie DIR [--fps N]\n"
-    "  aortasph bench [--threads N] [--quick] [--json FILE]\n"
+    "  aortasph bench [--threads N] [--quick] [--render] [--json FILE]\n"
     "  aortasph --help | --version\n"
     "\n"
     "exit codes: 0 ok, 1 compare: images differ, 2 bad input, 3 unstable simulation, 130 interrupted\n";
@@ -63,11 +64,13 @@ int dispatch(const std::vector<std::string>& args) {
   }
   if (cmd == "bench") {
     int threads = 0;
-    bool quick = false;
+    bool quick = false, render = false;
     std::string json = "bench.json";
     for (std::size_t k = 0; k < rest.size(); ++k) {
       if (rest[k] == "--quick") {
         quick = true;
+      } else if (rest[k] == "--render") {
+        render = true;
       } else if (rest[k] == "--threads" && k + 1 < rest.size()) {
         try {
           threads = std::stoi(rest[++k]);
@@ -81,9 +84,10 @@ int dispatch(const std::vector<std::string>& args) {
         throw InputError(rest[k] + ": unknown option for bench");
       }
     }
-    return cmd_bench(threads, quick, json);
+    return cmd_bench(threads, quick, render, json);
   }
-  if (cmd == "compare" || cmd == "movie") throw InputError(cmd + ": not available in this build yet (the renderer lands next)");
+  if (cmd == "compare") return cmd_compare(rest);
+  if (cmd == "movie") return cmd_movie(rest);
   throw InputError(cmd + ": unknown command (see aortasph --help)");
 }
 

@@ -54,7 +54,7 @@ TEST_CASE("a valid scene loads with its values and defaults", "[scene]") {
   CHECK(l.resolved["materials"]["water"]["eos_exponent"] == 7.0);
 }
 
-TEST_CASE("--set overrides nested keys, list entries and optional keys", "[scene]") {
+TEST_CASE("set overrides reach nested keys, list entries and optional keys", "[scene]") {
   const LoadedScene l = load_scene_json(good(), {"resolution.spacing=0.004", "bodies.0.velocity=[0,0,-1]",
                                                  "materials.water.viscosity=2e-6", "bodies.0.color=[1,0,0]",
                                                  "time.end=0.5"});

@@ -1,0 +1,203 @@
+#include "pipeline.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
+#include "figure.hpp"
+#include "renderer.hpp"
+
+namespace aortasph {
+
+namespace fs = std::filesystem;
+
+FramePipeline::FramePipeline(const RenderSettings& settings, fs::path out_dir, double output_interval,
+                             std::size_t capacity)
+    : settings_(settings),
+      out_dir_(std::move(out_dir)),
+      output_interval_(output_interval),
+      capacity_(std::max<std::size_t>(capacity, 1)) {
+  validate_render_settings(settings_);
+  if (!(output_interval_ > 0.0)) throw RenderError("time.output_interval must be positive for rendering");
+  for (const Figure& fig : settings_.figures) {
+    const std::string who = "render.figures \"" + fig.name + "\": ";
+    if (fig.name.empty()) throw RenderError("render.figures: a figure without a name");
+    if (std::none_of(settings_.cameras.begin(), settings_.cameras.end(),
+                     [&](const Camera& c) { return c.name == fig.camera; }))
+      throw RenderError(who + "unknown camera \"" + fig.camera + "\"");
+    if (fig.columns < 1) throw RenderError(who + "columns must be at least 1");
+    if (fig.times.empty()) throw RenderError(who + "no times");
+    for (double t : fig.times) {
+      if (!(t >= 0.0) || !std::isfinite(t)) throw RenderError(who + "times must be finite and >= 0");
+      wanted_[fig.camera].push_back(static_cast<int>(std::lround(t / output_interval_)));
+    }
+  }
+  std::error_code ec;
+  for (const Camera& camera : settings_.cameras) {
+    const fs::path dir = out_dir_ / "frames" / camera.name;
+    fs::create_directories(dir, ec);
+    if (ec) throw RenderError("cannot create " + dir.string() + ": " + ec.message());
+  }
+  std::promise<void> ready;
+  std::future<void> started = ready.get_future();
+  thread_ = std::thread(&FramePipeline::thread_main, this, &ready);
+  try {
+    started.get();
+  } catch (...) {
+    thread_.join();
+    throw;
+  }
+}
+
+FramePipeline::~FramePipeline() {
+  {
+    std::lock_guard lock(mutex_);
+    closing_ = true;
+    if (!finished_) queue_.clear();  // abandoned run: stop quickly
+  }
+  changed_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void FramePipeline::fail(const std::string& message) {
+  {
+    std::lock_guard lock(mutex_);
+    if (!failed_) error_ = message;
+    failed_ = true;
+    queue_.clear();
+  }
+  changed_.notify_all();
+}
+
+bool FramePipeline::failed() const {
+  std::lock_guard lock(mutex_);
+  return failed_;
+}
+
+std::string FramePipeline::error() const {
+  std::lock_guard lock(mutex_);
+  return error_;
+}
+
+void FramePipeline::push(Snapshot snapshot) {
+  std::unique_lock lock(mutex_);
+  if (closing_) throw RenderError("frame pipeline: push() after finish()");
+  changed_.wait(lock, [&] { return failed_ || queue_.size() < capacity_; });
+  if (failed_) throw RenderError(error_);
+  queue_.push_back(std::move(snapshot));
+  lock.unlock();
+  changed_.notify_all();
+}
+
+void FramePipeline::thread_main(std::promise<void>* ready) {
+  std::optional<Renderer> renderer;
+  try {
+    renderer.emplace(settings_);
+  } catch (...) {
+    ready->set_exception(std::current_exception());
+    return;
+  }
+  ready->set_value();  // `ready` dies with the constructor's frame: not touched after this
+  for (;;) {
+    Snapshot snapshot;
+    {
+      std::unique_lock lock(mutex_);
+      changed_.wait(lock, [&] { return closing_ || failed_ || !queue_.empty(); });
+      if (failed_ || queue_.empty()) break;  // closing with nothing left
+      snapshot = std::move(queue_.front());
+    }
+    try {
+      render_one(*renderer, snapshot);
+    } catch (const std::exception& e) {
+      fail("rendering frame " + std::to_string(snapshot.frame) + " (t = " + std::to_string(snapshot.time) +
+           " s): " + e.what());
+      break;
+    }
+    {
+      // Popped only after the frame is written, so the queue bound also counts the frame in hand.
+      std::lock_guard lock(mutex_);
+      if (!queue_.empty()) queue_.pop_front();
+    }
+    changed_.notify_all();
+  }
+  range_ = renderer->field_range();
+}
+
+void FramePipeline::render_one(Renderer& renderer, const Snapshot& snapshot) {
+  if (!snapshot.field_name.empty()) {
+    field_name_ = snapshot.field_name;
+    field_unit_ = snapshot.field_unit;
+  }
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%05d.png", snapshot.frame);
+  for (const Camera& camera : settings_.cameras) {
+    Image image = renderer.render(snapshot, camera);
+    write_png(out_dir_ / "frames" / camera.name / name, image);
+    const auto it = wanted_.find(camera.name);
+    if (it != wanted_.end() && std::count(it->second.begin(), it->second.end(), snapshot.frame)) {
+      int w = image.w, h = image.h;
+      if (w > kMaxPanelWidth) {
+        h = std::max(2, static_cast<int>(std::lround(static_cast<double>(h) * kMaxPanelWidth / w)) & ~1);
+        w = kMaxPanelWidth;
+      }
+      panels_[{camera.name, snapshot.frame}] = {snapshot.time, resize(image, w, h)};
+    }
+  }
+}
+
+void FramePipeline::finish() {
+  {
+    std::lock_guard lock(mutex_);
+    if (finished_) {
+      if (failed_) throw RenderError(error_);
+      return;
+    }
+    finished_ = true;
+    closing_ = true;
+  }
+  changed_.notify_all();
+  if (thread_.joinable()) thread_.join();
+  if (failed()) throw RenderError(error());
+  try {
+    write_figures();
+  } catch (const std::exception& e) {
+    fail(e.what());
+    throw RenderError(e.what());
+  }
+}
+
+void FramePipeline::write_figures() {
+  if (settings_.figures.empty()) return;
+  const fs::path dir = out_dir_ / "figures";
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw RenderError("cannot create " + dir.string() + ": " + ec.message());
+  std::optional<ColorBar> bar;
+  if (settings_.color_by != "material" && range_)
+    bar = ColorBar{settings_.colormap, range_->first, range_->second,
+                   field_name_.empty() ? settings_.color_by : field_name_, field_unit_};
+  for (const Figure& fig : settings_.figures) {
+    std::vector<FigurePanel> panels;
+    for (double t : fig.times) {
+      const int frame = static_cast<int>(std::lround(t / output_interval_));
+      const auto it = panels_.find({fig.camera, frame});
+      if (it == panels_.end()) {
+        std::cerr << "aortasph: warning: figure \"" << fig.name << "\": no frame at t = " << t
+                  << " s (the run ended earlier); left out\n";
+        continue;
+      }
+      char caption[64];
+      std::snprintf(caption, sizeof caption, "t = %.4g s", it->second.first);
+      panels.push_back({it->second.second, caption});
+    }
+    if (panels.empty()) {
+      std::cerr << "aortasph: warning: figure \"" << fig.name
+                << "\": none of its times was rendered; not written\n";
+      continue;
+    }
+    write_png(dir / (fig.name + ".png"), compose_figure(panels, fig.columns, bar));
+  }
+}
+
+}  // namespace aortasph

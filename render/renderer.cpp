@@ -1,0 +1,429 @@
+#include "renderer.hpp"
+
+#include <GL/osmesa.h>  // also brings gl.h and glext.h (GL_GLEXT_PROTOTYPES)
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <limits>
+
+#include "colormap.hpp"
+#include "embedded_shaders.hpp"
+#include "gl_context.hpp"
+
+namespace aortasph {
+
+namespace {
+
+constexpr int kMaxImageSize = 16384;  // llvmpipe's renderbuffer limit
+
+glm::dvec3 to_glm(const Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+std::string vec_str(const Vec3& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "[%g, %g, %g]", v.x(), v.y(), v.z());
+  return buf;
+}
+
+// One particle as the GPU sees it: 16 bytes.
+struct SplatVertex {
+  float position[3];
+  uint8_t color[4];
+};
+
+bool diverging(const std::string& colormap) {
+  return colormap == "coolwarm";
+}
+
+}  // namespace
+
+int msaa_samples() {
+  if (const char* env = std::getenv("AORTASPH_MSAA"); env && *env) {
+    const int n = std::atoi(env);
+    if (n == 1 || n == 2 || n == 4 || n == 8) return n;
+  }
+  return kMsaaSamples;
+}
+
+void validate_camera(const Camera& camera) {
+  const std::string who = "render.cameras \"" + camera.name + "\": ";
+  const Vec3 dir = camera.target - camera.eye;
+  if (!(dir.norm() > 0.0))
+    throw RenderError(who + "eye and target are the same point " + vec_str(camera.eye));
+  if (!(camera.up.norm() > 0.0)) throw RenderError(who + "up is the zero vector");
+  if (dir.normalized().cross(camera.up.normalized()).norm() < 1e-6)
+    throw RenderError(who + "the view direction " + vec_str(dir) + " is parallel to up " +
+                      vec_str(camera.up) + " (choose another up vector)");
+  if (!(camera.fov_deg > 0.0 && camera.fov_deg < 180.0))
+    throw RenderError(who + "fov_deg must be in (0, 180), got " + std::to_string(camera.fov_deg));
+}
+
+void validate_render_settings(const RenderSettings& s) {
+  for (const auto& [value, key] : {std::pair{s.width, "width"}, std::pair{s.height, "height"}}) {
+    if (value <= 0 || value % 2 != 0 || value > kMaxImageSize)
+      throw RenderError(std::string("render.") + key + ": must be a positive even number up to " +
+                        std::to_string(kMaxImageSize) + " (video encoders need even sizes), got " +
+                        std::to_string(value));
+  }
+  for (int c = 0; c < 3; ++c)
+    if (!(s.background[c] >= 0.0 && s.background[c] <= 1.0))
+      throw RenderError("render.background: components must be in [0, 1], got " + vec_str(s.background));
+  Colormap check(s.colormap);  // throws for an unknown name
+  if (s.color_by.empty()) throw RenderError("render.color_by: empty");
+  if (s.range &&
+      !(s.range->first < s.range->second && std::isfinite(s.range->first) && std::isfinite(s.range->second)))
+    throw RenderError("render.range: expected [min, max] with min < max");
+  if (s.clip && !(s.clip->normal.norm() > 0.0)) throw RenderError("render.clip.normal: zero vector");
+  for (const Camera& camera : s.cameras) validate_camera(camera);
+}
+
+struct Renderer::Impl {
+  RenderSettings settings;
+  Colormap colormap;
+  std::optional<std::pair<double, double>> range;
+  GlContext context;
+  GLuint splat_program = 0, mesh_program = 0;
+  GLuint splat_vao = 0, mesh_vao = 0, splat_vbo = 0, mesh_vbo = 0, mesh_ebo = 0;
+  GLuint ms_fbo = 0, ms_color = 0, ms_depth = 0, resolve_fbo = 0, resolve_color = 0;
+  float max_point_size = 64.0f;
+  std::vector<SplatVertex> splats;  // reused between frames
+
+  explicit Impl(const RenderSettings& s) : settings(s), colormap(s.colormap), range(s.range) {
+    splat_program = build_program("shaders/splat.vert.glsl", shaders::splat_vert_glsl,
+                                  "shaders/splat.frag.glsl", shaders::splat_frag_glsl);
+    mesh_program = build_program("shaders/mesh.vert.glsl", shaders::mesh_vert_glsl, "shaders/mesh.frag.glsl",
+                                 shaders::mesh_frag_glsl);
+    GLfloat range_px[2] = {1, 64};
+    glGetFloatv(GL_POINT_SIZE_RANGE, range_px);
+    max_point_size = range_px[1];
+
+    glGenVertexArrays(1, &splat_vao);
+    glGenBuffers(1, &splat_vbo);
+    glBindVertexArray(splat_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, splat_vbo);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(SplatVertex), nullptr);
+    glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(SplatVertex),
+                          reinterpret_cast<void*>(offsetof(SplatVertex, color)));
+    glEnableVertexAttribArray(0);
+    glEnableVertexAttribArray(1);
+
+    glGenVertexArrays(1, &mesh_vao);
+    glGenBuffers(1, &mesh_vbo);
+    glGenBuffers(1, &mesh_ebo);
+    glBindVertexArray(mesh_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, mesh_vbo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh_ebo);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(0);
+
+    const int w = settings.width, h = settings.height;
+    const int samples = msaa_samples();
+    glGenFramebuffers(1, &ms_fbo);
+    glGenRenderbuffers(1, &ms_color);
+    glGenRenderbuffers(1, &ms_depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, ms_color);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, w, h);
+    glBindRenderbuffer(GL_RENDERBUFFER, ms_depth);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT24, w, h);
+    glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ms_color);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw RenderError("OpenGL: multisampled framebuffer of " + std::to_string(w) + "x" + std::to_string(h) +
+                        " is incomplete");
+    glGenFramebuffers(1, &resolve_fbo);
+    glGenRenderbuffers(1, &resolve_color);
+    glBindRenderbuffer(GL_RENDERBUFFER, resolve_color);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+    glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, resolve_color);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw RenderError("OpenGL: resolve framebuffer is incomplete");
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    check_gl("renderer setup");
+  }
+
+  ~Impl() {
+    // The context may not be current on this thread any more (another Renderer drew since): make it so,
+    // then free; errors here are ignored, the context is going away anyway.
+    try {
+      context.make_current();
+    } catch (...) {
+      return;
+    }
+    glDeleteProgram(splat_program);
+    glDeleteProgram(mesh_program);
+    const GLuint buffers[] = {splat_vbo, mesh_vbo, mesh_ebo};
+    glDeleteBuffers(3, buffers);
+    const GLuint vaos[] = {splat_vao, mesh_vao};
+    glDeleteVertexArrays(2, vaos);
+    const GLuint fbos[] = {ms_fbo, resolve_fbo};
+    glDeleteFramebuffers(2, fbos);
+    const GLuint rbs[] = {ms_color, ms_depth, resolve_color};
+    glDeleteRenderbuffers(3, rbs);
+  }
+
+  bool use_field(const Snapshot& snap) const {
+    return settings.color_by != "material" && !snap.field.empty();
+  }
+
+  // The run's range is fixed at the first snapshot whose (drawn) field is not constant. Fields that never go
+  // negative (speed, stress, displacement) start at 0; diverging maps get a range symmetric about 0 so that
+  // the neutral colour means zero.
+  void choose_range(const Snapshot& snap) {
+    if (range || !use_field(snap)) return;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (size_t i = 0; i < snap.size(); ++i) {
+      const int b = snap.body[i];
+      if (b >= static_cast<int>(snap.bodies.size()) || snap.bodies[b].render != RenderMode::Particles)
+        continue;
+      const double v = snap.field[i];
+      if (!std::isfinite(v)) continue;
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+    if (!(hi > lo)) return;
+    if (diverging(settings.colormap)) {
+      const double m = std::max(std::abs(lo), std::abs(hi));
+      range = {-m, m};
+    } else {
+      range = {std::min(lo, 0.0), hi};
+    }
+  }
+
+  // Array sizes first: everything after indexes by particle.
+  static void check_sizes(const Snapshot& snap, bool field) {
+    const size_t n = snap.size();
+    if (snap.position.size() != 3 * n)
+      throw RenderError("snapshot: " + std::to_string(snap.position.size()) + " coordinates for " +
+                        std::to_string(n) + " particles");
+    if (field && snap.field.size() != n)
+      throw RenderError("snapshot: field \"" + snap.field_name + "\" has " +
+                        std::to_string(snap.field.size()) + " values for " + std::to_string(n) +
+                        " particles");
+  }
+
+  void build_splats(const Snapshot& snap) {
+    const size_t n = snap.size();
+    const bool field = use_field(snap);
+    const size_t nb = snap.bodies.size();
+    std::vector<uint8_t> draw(nb, 0), clipped(nb, 0);
+    std::vector<std::array<uint8_t, 4>> body_color(nb);
+    for (size_t b = 0; b < nb; ++b) {
+      draw[b] = snap.bodies[b].render == RenderMode::Particles;
+      for (int c = 0; c < 3; ++c)
+        body_color[b][c] =
+            static_cast<uint8_t>(std::lround(std::clamp(snap.bodies[b].color[c], 0.0f, 1.0f) * 255.0f));
+      body_color[b][3] = 255;
+    }
+    glm::dvec3 clip_n(0.0), clip_p(0.0);
+    if (settings.clip) {
+      clip_n = glm::normalize(to_glm(settings.clip->normal));
+      clip_p = to_glm(settings.clip->point);
+      for (int b : settings.clip->bodies)
+        if (b >= 0 && static_cast<size_t>(b) < nb) clipped[b] = 1;
+    }
+    const double lo = range ? range->first : 0.0;
+    const double inv = range ? 1.0 / (range->second - range->first) : 0.0;
+    splats.clear();
+    splats.reserve(n);
+    for (size_t i = 0; i < n; ++i) {
+      const size_t b = snap.body[i];
+      if (b >= nb)
+        throw RenderError("snapshot: particle " + std::to_string(i) + " belongs to body " +
+                          std::to_string(b) + " but there are " + std::to_string(nb) + " bodies");
+      if (!draw[b]) continue;
+      const float* p = &snap.position[3 * i];
+      if (clipped[b] &&
+          clip_n.x * (p[0] - clip_p.x) + clip_n.y * (p[1] - clip_p.y) + clip_n.z * (p[2] - clip_p.z) > 0.0)
+        continue;
+      SplatVertex v;
+      std::memcpy(v.position, p, sizeof v.position);
+      if (field) {
+        // Before a range exists (constant field so far) every value maps to the bottom of the map.
+        const auto c = colormap((snap.field[i] - lo) * inv);
+        v.color[0] = c[0];
+        v.color[1] = c[1];
+        v.color[2] = c[2];
+        v.color[3] = 255;
+      } else {
+        std::memcpy(v.color, body_color[b].data(), 4);
+      }
+      splats.push_back(v);
+    }
+  }
+
+  // Near and far planes enclosing everything drawn, so depth precision follows the scene's scale.
+  std::pair<double, double> depth_bounds(const Snapshot& snap, const glm::dvec3& eye, const glm::dvec3& dir) {
+    double dmin = std::numeric_limits<double>::infinity(), dmax = -dmin;
+    auto add = [&](const float* p) {
+      const double d = (p[0] - eye.x) * dir.x + (p[1] - eye.y) * dir.y + (p[2] - eye.z) * dir.z;
+      dmin = std::min(dmin, d);
+      dmax = std::max(dmax, d);
+    };
+    for (const SplatVertex& v : splats) add(v.position);
+    for (const BodyView& body : snap.bodies)
+      if (body.render == RenderMode::Surface)
+        for (const auto& p : body.mesh.vertices) add(p.data());
+    const double margin = snap.spacing + 1e-6;
+    if (!(dmax > 0.0)) return {0.01, 1.0};  // nothing in front of the camera
+    const double far = dmax + margin;
+    const double near = std::max(dmin - margin, far * 1e-4);
+    return {near, far};
+  }
+
+  Image render(const Snapshot& snap, const Camera& camera) {
+    validate_camera(camera);
+    context.make_current();
+    check_sizes(snap, use_field(snap));
+    choose_range(snap);
+    build_splats(snap);
+
+    const int w = settings.width, h = settings.height;
+    const glm::dvec3 eye = to_glm(camera.eye), target = to_glm(camera.target);
+    const glm::dvec3 dir = glm::normalize(target - eye);
+    const auto [near, far] = depth_bounds(snap, eye, dir);
+    const glm::mat4 view = glm::mat4(glm::lookAt(eye, target, to_glm(camera.up)));
+    const glm::mat4 proj =
+        glm::mat4(glm::perspective(glm::radians(camera.fov_deg), static_cast<double>(w) / h, near, far));
+    const float* light = Lighting::kLightDir;
+
+    glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
+    glViewport(0, 0, w, h);
+    glClearColor(static_cast<float>(settings.background.x()), static_cast<float>(settings.background.y()),
+                 static_cast<float>(settings.background.z()), 1.0f);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glEnable(GL_MULTISAMPLE);
+
+    if (!splats.empty()) {
+      glUseProgram(splat_program);
+      glUniformMatrix4fv(glGetUniformLocation(splat_program, "u_view"), 1, GL_FALSE, glm::value_ptr(view));
+      glUniformMatrix4fv(glGetUniformLocation(splat_program, "u_proj"), 1, GL_FALSE, glm::value_ptr(proj));
+      glUniform1f(glGetUniformLocation(splat_program, "u_radius"), static_cast<float>(snap.spacing * 0.5));
+      glUniform2f(glGetUniformLocation(splat_program, "u_viewport"), static_cast<float>(w),
+                  static_cast<float>(h));
+      glUniform1f(glGetUniformLocation(splat_program, "u_max_point_size"), max_point_size);
+      glUniform3fv(glGetUniformLocation(splat_program, "u_light_dir"), 1, light);
+      glUniform1f(glGetUniformLocation(splat_program, "u_ambient"), Lighting::kAmbient);
+      glUniform1f(glGetUniformLocation(splat_program, "u_diffuse"), Lighting::kDiffuse);
+      glUniform1f(glGetUniformLocation(splat_program, "u_specular"), Lighting::kSpecular);
+      glUniform1f(glGetUniformLocation(splat_program, "u_shininess"), Lighting::kShininess);
+      glBindVertexArray(splat_vao);
+      glBindBuffer(GL_ARRAY_BUFFER, splat_vbo);
+      glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(splats.size() * sizeof(SplatVertex)),
+                   splats.data(), GL_STREAM_DRAW);
+      glDepthMask(GL_TRUE);
+      glDisable(GL_BLEND);
+      glEnable(GL_SAMPLE_ALPHA_TO_COVERAGE);
+      glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(splats.size()));
+      glDisable(GL_SAMPLE_ALPHA_TO_COVERAGE);
+    }
+
+    // Translucent surfaces after the opaque splats, without depth writes, so particles behind a wall show
+    // through it and overlapping wall layers all contribute.
+    bool any_mesh = false;
+    for (const BodyView& body : snap.bodies)
+      any_mesh |= body.render == RenderMode::Surface && !body.mesh.empty();
+    if (any_mesh) {
+      glUseProgram(mesh_program);
+      glUniformMatrix4fv(glGetUniformLocation(mesh_program, "u_view"), 1, GL_FALSE, glm::value_ptr(view));
+      glUniformMatrix4fv(glGetUniformLocation(mesh_program, "u_proj"), 1, GL_FALSE, glm::value_ptr(proj));
+      glUniform3fv(glGetUniformLocation(mesh_program, "u_light_dir"), 1, light);
+      glUniform1f(glGetUniformLocation(mesh_program, "u_ambient"), Lighting::kAmbient);
+      glUniform1f(glGetUniformLocation(mesh_program, "u_diffuse"), Lighting::kDiffuse);
+      glUniform1f(glGetUniformLocation(mesh_program, "u_alpha"), Lighting::kMeshAlpha);
+      glm::vec4 plane(0.0f);
+      if (settings.clip) {
+        const glm::dvec3 n = glm::normalize(to_glm(settings.clip->normal));
+        plane = glm::vec4(glm::vec3(n), static_cast<float>(-glm::dot(n, to_glm(settings.clip->point))));
+      }
+      glUniform4fv(glGetUniformLocation(mesh_program, "u_clip_plane"), 1, glm::value_ptr(plane));
+      glBindVertexArray(mesh_vao);
+      // GL_ARRAY_BUFFER is global state, not part of the VAO: the splat buffer may still be bound.
+      glBindBuffer(GL_ARRAY_BUFFER, mesh_vbo);
+      glDepthMask(GL_FALSE);
+      glEnable(GL_BLEND);
+      glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+      glDisable(GL_CULL_FACE);
+      for (size_t b = 0; b < snap.bodies.size(); ++b) {
+        const BodyView& body = snap.bodies[b];
+        if (body.render != RenderMode::Surface || body.mesh.empty()) continue;
+        const size_t nv = body.mesh.vertices.size();
+        for (const auto& t : body.mesh.triangles)
+          if (t[0] >= nv || t[1] >= nv || t[2] >= nv)
+            throw RenderError("snapshot: mesh of body \"" + body.name + "\" indexes a missing vertex");
+        const bool clip = settings.clip && std::count(settings.clip->bodies.begin(),
+                                                      settings.clip->bodies.end(), static_cast<int>(b)) > 0;
+        if (clip)
+          glEnable(GL_CLIP_DISTANCE0);
+        else
+          glDisable(GL_CLIP_DISTANCE0);
+        glUniform3f(glGetUniformLocation(mesh_program, "u_color"), body.color[0], body.color[1],
+                    body.color[2]);
+        glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(nv * sizeof(body.mesh.vertices[0])),
+                     body.mesh.vertices.data(), GL_STREAM_DRAW);
+        glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+                     static_cast<GLsizeiptr>(body.mesh.triangles.size() * sizeof(body.mesh.triangles[0])),
+                     body.mesh.triangles.data(), GL_STREAM_DRAW);
+        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * body.mesh.triangles.size()), GL_UNSIGNED_INT,
+                       nullptr);
+      }
+      glDisable(GL_CLIP_DISTANCE0);
+      glDisable(GL_BLEND);
+      glDepthMask(GL_TRUE);
+    }
+
+    // Resolve the samples, then read back; GL rows run bottom-up, images top-down.
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
+    glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo);
+    Image image(w, h);
+    std::vector<uint8_t> rows(static_cast<size_t>(w) * h * 3);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, rows.data());
+    check_gl("drawing a frame");
+    const size_t stride = static_cast<size_t>(w) * 3;
+    for (int y = 0; y < h; ++y)
+      std::memcpy(image.rgb.data() + static_cast<size_t>(y) * stride,
+                  rows.data() + static_cast<size_t>(h - 1 - y) * stride, stride);
+    return image;
+  }
+};
+
+namespace {
+const RenderSettings& validated(const RenderSettings& s) {
+  validate_render_settings(s);
+  return s;
+}
+}  // namespace
+
+Renderer::Renderer(const RenderSettings& settings) : impl_(std::make_unique<Impl>(validated(settings))) {}
+Renderer::~Renderer() = default;
+
+Image Renderer::render(const Snapshot& snapshot, const Camera& camera) {
+  return impl_->render(snapshot, camera);
+}
+
+std::optional<std::pair<double, double>> Renderer::field_range() const {
+  if (impl_->settings.color_by == "material") return std::nullopt;
+  return impl_->range;
+}
+
+const RenderSettings& Renderer::settings() const {
+  return impl_->settings;
+}
+std::string Renderer::gl_renderer() const {
+  return impl_->context.renderer_name();
+}
+
+}  // namespace aortasph

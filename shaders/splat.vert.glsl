@@ -1,0 +1,36 @@
+#version 330 core
+// Particle splats: one GL_POINT per particle, drawn as a lit sphere impostor by splat.frag.glsl.
+// The point size is the sphere's projected diameter in pixels, so splats scale with distance.
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec4 a_color;
+
+uniform mat4 u_view;
+uniform mat4 u_proj;
+uniform float u_radius;           // world units (spacing / 2)
+uniform vec2 u_viewport;  // pixels
+uniform float u_max_point_size;   // the implementation's limit (255 on llvmpipe)
+
+flat out vec3 v_center;  // view space
+flat out vec3 v_color;
+flat out float v_half_size;  // radius in pixels
+flat out vec2 v_center_px;   // window coordinates of the centre
+
+void main() {
+  vec4 view = u_view * vec4(a_position, 1.0);
+  v_center = view.xyz;
+  v_color = a_color.rgb;
+  gl_Position = u_proj * view;
+  // The sprite's own depth is that of the sphere's front point, the nearest the impostor can be: the fragment
+  // shader only ever moves depth backwards from there (declared with depth_greater), which lets the rasteriser
+  // reject hidden fragments early.
+  vec4 front = u_proj * vec4(view.xy, view.z + u_radius, 1.0);
+  gl_Position.z = front.z / front.w * gl_Position.w;
+  // Diameter in pixels: 2 r / w scales NDC units (2 per viewport height) by proj[1][1].
+  float w = max(gl_Position.w, 1e-6);
+  float diameter = u_radius * u_proj[1][1] * u_viewport.y / w;
+  // Two pixels of slack so the anti-aliased rim always gets fragments, whatever rounding of the sprite size
+  // and position the rasteriser applies.
+  gl_PointSize = clamp(diameter + 2.0, 1.0, u_max_point_size);
+  v_half_size = 0.5 * min(diameter, u_max_point_size - 2.0);
+  v_center_px = (gl_Position.xy / w * 0.5 + 0.5) * u_viewport;
+}

@@ -1,0 +1,503 @@
+// Renderer tests: golden images with known answers, determinism, the frame pipeline, compare/movie commands
+// and bad input. Small images (64..160 px) keep the whole file to a few seconds, also in unoptimised builds.
+//
+// Golden images live in tests/golden/. They are compared through the same code as `aortasph compare`
+// (render/image_compare) with kGoldenTolerance: the largest allowed difference of one colour channel.
+// llvmpipe is deterministic, so on one machine the difference is 0; the small allowance absorbs rounding
+// differences between Mesa/LLVM versions, while any real change (camera, colour, lighting, size) exceeds it
+// by far (proved by the "deliberate change" test). To regenerate the goldens after an intended change, run
+//   AORTASPH_UPDATE_GOLDEN=1 ./aortasph_tests "[render]"
+// look at the new tests/golden/*.png, and commit them.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "colormap.hpp"
+#include "figure.hpp"
+#include "gl_context.hpp"
+#include "image_compare.hpp"
+#include "pipeline.hpp"
+#include "render_commands.hpp"
+#include "renderer.hpp"
+
+using namespace aortasph;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kGoldenTolerance = 2;
+
+fs::path golden_dir() {
+  return fs::path(AORTASPH_TEST_DIR) / "golden";
+}
+
+bool updating_goldens() {
+  const char* env = std::getenv("AORTASPH_UPDATE_GOLDEN");
+  return env && std::string(env) == "1";
+}
+
+// Compares with tests/golden/<name> (or rewrites it when updating); returns the difference.
+ImageDiff check_golden(const std::string& name, const Image& image) {
+  const fs::path path = golden_dir() / name;
+  if (updating_goldens()) write_png(path, image);
+  const ImageDiff d = compare_images(read_png(path), image);
+  INFO(describe(name, d));
+  CHECK(d.within(kGoldenTolerance));
+  return d;
+}
+
+fs::path scratch_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("aortasph_test_render_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+RenderSettings small_settings(int w, int h) {
+  RenderSettings s;
+  s.width = w;
+  s.height = h;
+  s.background = Vec3(0, 0, 0);
+  return s;
+}
+
+Camera front_camera(double distance = 2.0) {
+  Camera c;
+  c.name = "front";
+  c.eye = Vec3(0, 0, distance);
+  c.target = Vec3(0, 0, 0);
+  c.fov_deg = 35;
+  return c;
+}
+
+BodyView body(const std::string& name, std::array<float, 3> color, RenderMode mode = RenderMode::Particles) {
+  BodyView b;
+  b.name = name;
+  b.color = color;
+  b.render = mode;
+  return b;
+}
+
+Snapshot one_splat(std::array<float, 3> color = {0.9f, 0.3f, 0.1f}) {
+  Snapshot s;
+  s.spacing = 0.5;
+  s.position = {0, 0, 0};
+  s.body = {0};
+  s.bodies.push_back(body("ball", color));
+  return s;
+}
+
+// A square of side 2 in the plane z = z0, facing +z, as two triangles.
+SurfaceMesh square(float z0, float half = 1.0f) {
+  SurfaceMesh m;
+  m.vertices = {{-half, -half, z0}, {half, -half, z0}, {half, half, z0}, {-half, half, z0}};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return m;
+}
+
+// Particles along x coloured by a field from 0 to 1 (a colormap strip).
+Snapshot strip(int n) {
+  Snapshot s;
+  s.spacing = 2.0 / n;
+  s.field_name = "speed";
+  s.field_unit = "m/s";
+  s.bodies.push_back(body("strip", {1, 1, 1}));
+  for (int i = 0; i < n; ++i) {
+    s.position.insert(s.position.end(), {static_cast<float>(-1.0 + (i + 0.5) * s.spacing), 0.0f, 0.0f});
+    s.body.push_back(0);
+    s.field.push_back(static_cast<float>(i) / (n - 1));
+  }
+  return s;
+}
+
+// A small composite scene: a block of "water" particles in a translucent box, a red rigid ball, the box cut
+// by a clip plane, and a hidden body that must not appear.
+Snapshot composite_scene() {
+  Snapshot s;
+  s.spacing = 0.1;
+  s.bodies = {body("water", {0.2f, 0.45f, 0.9f}), body("ball", {0.85f, 0.2f, 0.15f}),
+              body("tank", {0.6f, 0.6f, 0.6f}, RenderMode::Surface),
+              body("ghost", {0, 1, 0}, RenderMode::Hidden)};
+  for (int x = 0; x < 8; ++x)
+    for (int y = 0; y < 4; ++y)
+      for (int z = 0; z < 5; ++z) {
+        s.position.insert(s.position.end(), {-0.75f + 0.1f * x, -0.45f + 0.1f * y, -0.25f + 0.1f * z});
+        s.body.push_back(0);
+      }
+  s.position.insert(s.position.end(), {0.4f, 0.2f, 0.0f, 0.5f, 0.2f, 0.0f, 0.0f, 0.5f, 0.0f});
+  s.body.insert(s.body.end(), {1, 1, 3});
+  // Open-top box 1.8 x 1.0 x 0.8 from quads.
+  SurfaceMesh& m = s.bodies[2].mesh;
+  const float X = 0.9f, Y0 = -0.5f, Y1 = 0.5f, Z = 0.4f;
+  auto quad = [&](std::array<float, 3> a, std::array<float, 3> b, std::array<float, 3> c,
+                  std::array<float, 3> d) {
+    const auto k = static_cast<uint32_t>(m.vertices.size());
+    m.vertices.insert(m.vertices.end(), {a, b, c, d});
+    m.triangles.push_back({k, k + 1, k + 2});
+    m.triangles.push_back({k, k + 2, k + 3});
+  };
+  quad({-X, Y0, -Z}, {X, Y0, -Z}, {X, Y0, Z}, {-X, Y0, Z});    // floor
+  quad({-X, Y0, -Z}, {X, Y0, -Z}, {X, Y1, -Z}, {-X, Y1, -Z});  // back
+  quad({-X, Y0, Z}, {X, Y0, Z}, {X, Y1, Z}, {-X, Y1, Z});      // front
+  quad({-X, Y0, -Z}, {-X, Y0, Z}, {-X, Y1, Z}, {-X, Y1, -Z});  // left
+  quad({X, Y0, -Z}, {X, Y0, Z}, {X, Y1, Z}, {X, Y1, -Z});      // right
+  return s;
+}
+
+RenderSettings composite_settings() {
+  RenderSettings s = small_settings(160, 96);
+  s.background = Vec3(1, 1, 1);
+  s.clip = Clip{Vec3(0, 0, 0.1), Vec3(0, 0, 1), {2}};
+  return s;
+}
+
+Camera composite_camera() {
+  Camera c;
+  c.name = "three_quarter";
+  c.eye = Vec3(1.6, 1.3, 2.4);
+  c.target = Vec3(0, -0.1, 0);
+  c.fov_deg = 40;
+  return c;
+}
+
+int lum(const uint8_t* p) {
+  return p[0] + p[1] + p[2];
+}
+
+}  // namespace
+
+TEST_CASE("render: one splat centred in view has the lit colour and a centred, symmetric disc", "[render]") {
+  Renderer renderer(small_settings(64, 64));
+  const std::array<float, 3> color = {0.9f, 0.3f, 0.1f};
+  const Image image = renderer.render(one_splat(color), front_camera());
+  check_golden("render_splat.png", image);
+
+  // Near the centre, shade = colour * (ambient + diffuse * n.L) + specular * (n.h)^shininess with the
+  // sphere's normal n at each pixel centre (the image centre is a pixel corner, so the four pixels around it
+  // are checked).
+  const float* L = Lighting::kLightDir;
+  const double f = 1.0 / std::tan(17.5 * M_PI / 180.0);  // proj[1][1]
+  const double half_px = 0.25 * f * 64 / 2.0 / 2.0;      // r * proj11 * height / distance / 2
+  const double hn = std::sqrt(L[0] * L[0] + L[1] * L[1] + (L[2] + 1.0) * (L[2] + 1.0));
+  for (int y : {31, 32})
+    for (int x : {31, 32}) {
+      const double px = (x + 0.5 - 32) / half_px, py = (32 - (y + 0.5)) / half_px;
+      const double nz = std::sqrt(1 - px * px - py * py);
+      const double diffuse = px * L[0] + py * L[1] + nz * L[2];
+      const double spec = Lighting::kSpecular *
+                          std::pow((px * L[0] + py * L[1] + nz * (L[2] + 1.0)) / hn, Lighting::kShininess);
+      for (int c = 0; c < 3; ++c) {
+        const double expected =
+            255.0 * (color[c] * (Lighting::kAmbient + Lighting::kDiffuse * diffuse) + spec);
+        CHECK(std::abs(image.at(x, y)[c] - std::min(255.0, expected)) <= 2.0);
+      }
+    }
+  // The disc: its bounding box is centred and its diameter is the projected one,
+  // d = 2 r f / (distance) with f = (h/2) / tan(fov/2) for a sphere of radius r = spacing / 2.
+  int x0 = 64, x1 = -1, y0 = 64, y1 = -1;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      if (lum(image.at(x, y)) > 0) {
+        x0 = std::min(x0, x);
+        x1 = std::max(x1, x);
+        y0 = std::min(y0, y);
+        y1 = std::max(y1, y);
+      }
+  CHECK(x0 + x1 == 63);
+  CHECK(y0 + y1 == 63);
+  const double diameter = 2 * half_px;
+  CHECK(std::abs((x1 - x0 + 1) - diameter) <= 2.0);
+  // Coverage symmetric left/right and top/bottom (silhouette, not shading: the light comes from one side).
+  int asym = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 32; ++x) {
+      asym += (lum(image.at(x, y)) > 0) != (lum(image.at(63 - x, y)) > 0);
+      asym += (lum(image.at(y, x)) > 0) != (lum(image.at(y, 63 - x)) > 0);
+    }
+  CHECK(asym <= 8);
+}
+
+TEST_CASE("render: a translucent lit plane facing the camera has the computed mean colour", "[render]") {
+  RenderSettings settings = small_settings(64, 48);
+  settings.background = Vec3(0.2, 0.4, 0.6);
+  Renderer renderer(settings);
+  Snapshot snap;
+  snap.bodies.push_back(body("wall", {0.8f, 0.6f, 0.2f}, RenderMode::Surface));
+  snap.bodies[0].mesh = square(0.0f, 5.0f);  // fills the view
+  const Image image = renderer.render(snap, front_camera());
+  check_golden("render_plane.png", image);
+  const double a = Lighting::kMeshAlpha;
+  const double shade = Lighting::kAmbient + Lighting::kDiffuse * Lighting::kLightDir[2];
+  for (int c = 0; c < 3; ++c) {
+    double mean = 0;
+    for (int i = 0; i < 64 * 48; ++i) mean += image.rgb[3 * i + c];
+    mean /= 64 * 48;
+    const double expected = 255.0 * (a * snap.bodies[0].color[c] * shade + (1 - a) * settings.background[c]);
+    CHECK(std::abs(mean - expected) <= 1.0);
+  }
+}
+
+TEST_CASE("render: colormap strips through the field path", "[render]") {
+  for (const std::string map : {"viridis", "coolwarm"}) {
+    RenderSettings settings = small_settings(128, 32);
+    settings.color_by = "speed";
+    settings.colormap = map;
+    settings.range = std::make_pair(0.0, 1.0);
+    Renderer renderer(settings);
+    Camera cam = front_camera(0.9);  // the strip spans the width
+    const Image image = renderer.render(strip(16), cam);
+    check_golden("render_strip_" + map + ".png", image);
+  }
+  // Anchor values of the maps themselves.
+  const Colormap viridis("viridis"), coolwarm("coolwarm");
+  CHECK(viridis(0.0) == std::array<uint8_t, 3>{68, 1, 84});
+  CHECK(viridis(1.0) == std::array<uint8_t, 3>{253, 231, 37});
+  CHECK(viridis(0.5) == std::array<uint8_t, 3>{33, 145, 140});
+  CHECK(coolwarm(0.5) == std::array<uint8_t, 3>{221, 221, 221});
+  CHECK(viridis(-3.0) == viridis(0.0));
+  CHECK(viridis(std::nan("")) == viridis(0.0));
+}
+
+TEST_CASE("render: composite scene (splats, translucent clipped box, hidden body)", "[render]") {
+  Renderer renderer(composite_settings());
+  const Snapshot snap = composite_scene();
+  const Image image = renderer.render(snap, composite_camera());
+  check_golden("render_scene.png", image);
+  // The hidden body's bright green never shows.
+  int green = 0;
+  for (int i = 0; i < image.w * image.h; ++i)
+    green += image.rgb[3 * i + 1] > 200 && image.rgb[3 * i] < 80 && image.rgb[3 * i + 2] < 80;
+  CHECK(green == 0);
+}
+
+TEST_CASE("render: a deliberate change fails the golden comparison", "[render]") {
+  const Image golden = read_png(golden_dir() / "render_scene.png");
+  {
+    Renderer renderer(composite_settings());
+    Camera moved = composite_camera();
+    moved.eye += Vec3(0.05, 0, 0);  // a few centimetres
+    const ImageDiff d = compare_images(golden, renderer.render(composite_scene(), moved));
+    INFO(describe("moved camera", d));
+    CHECK_FALSE(d.within(kGoldenTolerance));
+  }
+  {
+    Renderer renderer(composite_settings());
+    Snapshot recoloured = composite_scene();
+    recoloured.bodies[1].color = {0.8f, 0.25f, 0.15f};  // the ball, slightly less red
+    const ImageDiff d = compare_images(golden, renderer.render(recoloured, composite_camera()));
+    INFO(describe("recoloured ball", d));
+    CHECK_FALSE(d.within(kGoldenTolerance));
+  }
+}
+
+TEST_CASE("render: frames are bitwise identical across renders and renderers", "[render]") {
+  const Snapshot snap = composite_scene();
+  Renderer first(composite_settings());
+  const Image a = first.render(snap, composite_camera());
+  const Image b = first.render(snap, composite_camera());
+  Renderer second(composite_settings());
+  const Image c = second.render(snap, composite_camera());
+  CHECK(a == b);
+  CHECK(a == c);
+  // And the PNG bytes too.
+  CHECK(encode_png(a) == encode_png(c));
+}
+
+TEST_CASE("render: the field range is chosen once, from the first non-constant field", "[render]") {
+  RenderSettings settings = small_settings(32, 32);
+  settings.color_by = "speed";
+  Renderer renderer(settings);
+  Snapshot snap = strip(4);
+  snap.field = {0, 0, 0, 0};
+  renderer.render(snap, front_camera());
+  CHECK_FALSE(renderer.field_range().has_value());
+  snap.field = {0.5f, 1, 2, 3};
+  renderer.render(snap, front_camera());
+  REQUIRE(renderer.field_range().has_value());
+  CHECK(renderer.field_range()->first == 0.0);  // speeds start at 0
+  CHECK(renderer.field_range()->second == 3.0);
+  snap.field = {0, 10, 20, 30};
+  renderer.render(snap, front_camera());
+  CHECK(renderer.field_range()->second == 3.0);  // kept for the whole run
+}
+
+TEST_CASE("render: bad input raises RenderError with a clear message", "[render]") {
+  auto message_of = [](auto&& f) -> std::string {
+    try {
+      f();
+    } catch (const RenderError& e) {
+      return e.what();
+    }
+    return "(no error)";
+  };
+  RenderSettings s = small_settings(32, 32);
+  s.colormap = "rainbow";
+  CHECK_THAT(message_of([&] { Renderer r(s); }), Catch::Contains("unknown colormap \"rainbow\""));
+  s = small_settings(0, 32);
+  CHECK_THAT(message_of([&] { Renderer r(s); }), Catch::Contains("render.width"));
+  s = small_settings(32, 31);
+  CHECK_THAT(message_of([&] { Renderer r(s); }), Catch::Contains("render.height"));
+  Camera along_up = front_camera();
+  along_up.eye = Vec3(0, 3, 0);
+  CHECK_THAT(message_of([&] { validate_camera(along_up); }), Catch::Contains("parallel to up"));
+  s = small_settings(32, 32);
+  Renderer renderer(s);
+  CHECK_THAT(message_of([&] { renderer.render(one_splat(), along_up); }), Catch::Contains("parallel to up"));
+  s.cameras.push_back(along_up);
+  CHECK_THAT(message_of([&] { FramePipeline p(s, scratch_dir("bad"), 0.1); }),
+             Catch::Contains("parallel to up"));
+  Snapshot broken = one_splat();
+  broken.body = {5};
+  CHECK_THAT(message_of([&] { renderer.render(broken, front_camera()); }), Catch::Contains("body 5"));
+
+  RenderSettings by_speed = small_settings(32, 32);
+  by_speed.color_by = "speed";
+  Renderer speed_renderer(by_speed);
+  Snapshot short_field = strip(4);
+  short_field.field.pop_back();
+  CHECK_THAT(message_of([&] { speed_renderer.render(short_field, front_camera()); }),
+             Catch::Contains("3 values for 4 particles"));
+
+  // A shader that fails to compile names its file and line.
+  GlContext context;
+  const std::string vert = "#version 330 core\nvoid main() { gl_Position = vec4(0.0); }\n";
+  const std::string frag = "#version 330 core\nout vec4 c;\nvoid main() {\n  c = vec4(undefined_thing);\n}\n";
+  const std::string msg =
+      message_of([&] { build_program("shaders/ok.vert.glsl", vert, "shaders/bad.frag.glsl", frag); });
+  CHECK_THAT(msg, Catch::Contains("shaders/bad.frag.glsl:4:"));
+  CHECK_THAT(msg, Catch::Contains("undefined_thing"));
+}
+
+TEST_CASE("render: PNG write/read round trip; a failed write leaves no file", "[render]") {
+  const fs::path dir = scratch_dir("png");
+  Image image(6, 4, 10, 20, 30);
+  image.at(5, 3)[0] = 255;
+  write_png(dir / "a.png", image);
+  CHECK(read_png(dir / "a.png") == image);
+  CHECK_THROWS_AS(write_png(dir / "missing_folder" / "b.png", image), RenderError);
+  CHECK_FALSE(fs::exists(dir / "missing_folder"));
+  CHECK_THROWS_AS(read_png(dir / "nothing.png"), RenderError);
+  std::ofstream(dir / "fake.png") << "not a png";
+  CHECK_THROWS_AS(read_png(dir / "fake.png"), RenderError);
+}
+
+TEST_CASE("render: frame pipeline writes numbered frames and an even-sized figure", "[render]") {
+  const fs::path out = scratch_dir("pipeline");
+  RenderSettings settings = small_settings(96, 64);
+  settings.color_by = "speed";
+  settings.cameras = {front_camera(3.35), composite_camera()};
+  settings.cameras[1].name = "side";
+  settings.figures = {Figure{"sheet", "front", {0.0, 0.1, 0.2}, 2}};
+  {
+    FramePipeline pipeline(settings, out, 0.1);
+    for (int k = 0; k < 4; ++k) {
+      Snapshot s = strip(12);
+      s.frame = k;
+      s.time = 0.1 * k;
+      for (float& v : s.field) v *= static_cast<float>(k + 1);
+      pipeline.push(std::move(s));
+    }
+    pipeline.finish();
+    CHECK_FALSE(pipeline.failed());
+  }
+  for (const std::string cam : {"front", "side"})
+    for (int k = 0; k < 4; ++k) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%05d.png", k);
+      const Image frame = read_png(out / "frames" / cam / name);
+      CHECK(frame.w == 96);
+      CHECK(frame.h == 64);
+    }
+  CHECK_FALSE(fs::exists(out / "frames" / "front" / "frame_00004.png"));
+  const Image sheet = read_png(out / "figures" / "sheet.png");
+  CHECK(sheet.w % 2 == 0);
+  CHECK(sheet.h % 2 == 0);
+  CHECK(sheet.w > 2 * 96);
+  CHECK(sheet.h > 2 * 64);
+}
+
+TEST_CASE("render: a render-thread error stops the pipeline with a message", "[render]") {
+  RenderSettings settings = small_settings(32, 32);
+  settings.cameras = {front_camera()};
+  FramePipeline pipeline(settings, scratch_dir("pipeline_error"), 0.1);
+  Snapshot bad = one_splat();
+  bad.body = {7};  // a body that does not exist
+  bool threw = false;
+  try {
+    pipeline.push(bad);
+    for (int k = 0; k < 10; ++k) pipeline.push(one_splat());  // soon refused
+    pipeline.finish();
+  } catch (const RenderError& e) {
+    threw = true;
+    CHECK_THAT(std::string(e.what()), Catch::Contains("body 7"));
+  }
+  CHECK(threw);
+  CHECK(pipeline.failed());
+}
+
+TEST_CASE("render: figure sheet composition labels panels and adds a colour bar", "[render]") {
+  CHECK(panel_label(0) == "(a)");
+  CHECK(panel_label(5) == "(f)");
+  CHECK(panel_label(26) == "(aa)");
+  std::vector<FigurePanel> panels;
+  for (int k = 0; k < 3; ++k)
+    panels.push_back({Image(40, 30, 50 * k, 100, 150), "t = 0." + std::to_string(k) + " s"});
+  const Image plain = compose_figure(panels, 2, std::nullopt);
+  const Image with_bar = compose_figure(panels, 2, ColorBar{"viridis", 0.0, 1.5, "speed", "m/s"});
+  CHECK(plain.w % 2 == 0);
+  CHECK(plain.h % 2 == 0);
+  CHECK(with_bar.h > plain.h);
+  CHECK(with_bar.w == plain.w);
+  check_golden("render_figure.png", with_bar);
+  CHECK_THROWS_AS(compose_figure({}, 2, std::nullopt), RenderError);
+}
+
+TEST_CASE("render: compare command exit codes and messages", "[render]") {
+  const fs::path dir = scratch_dir("compare");
+  Image a(8, 8, 100, 100, 100), b = a, c(8, 6, 0, 0, 0);
+  b.at(3, 3)[1] = 104;
+  write_png(dir / "a.png", a);
+  write_png(dir / "b.png", b);
+  write_png(dir / "c.png", c);
+  const std::string A = (dir / "a.png").string(), B = (dir / "b.png").string();
+  CHECK(cmd_compare({A, A}) == 0);
+  CHECK(cmd_compare({A, B}) == 1);
+  CHECK(cmd_compare({A, B, "--tolerance", "4"}) == 0);
+  CHECK(cmd_compare({A, B, "--tolerance", "3", "--diff", (dir / "diff.png").string()}) == 1);
+  CHECK(read_png(dir / "diff.png").at(3, 3)[0] > 128);
+  CHECK(cmd_compare({A, (dir / "c.png").string()}) == 2);     // size mismatch
+  CHECK(cmd_compare({A, (dir / "none.png").string()}) == 2);  // missing
+  CHECK(cmd_compare({A, B, "--tolerance", "x"}) == 2);
+  CHECK(cmd_compare({A}) == 2);
+  // Folders: same names compare pairwise; different sets are bad input.
+  fs::create_directories(dir / "x");
+  fs::create_directories(dir / "y");
+  write_png(dir / "x" / "f.png", a);
+  write_png(dir / "y" / "f.png", b);
+  CHECK(cmd_compare({(dir / "x").string(), (dir / "y").string()}) == 1);
+  CHECK(cmd_compare({(dir / "x").string(), (dir / "y").string(), "--tolerance", "4"}) == 0);
+  write_png(dir / "y" / "g.png", b);
+  CHECK(cmd_compare({(dir / "x").string(), (dir / "y").string()}) == 2);
+}
+
+TEST_CASE("render: movie command", "[render]") {
+  const fs::path dir = scratch_dir("movie");
+  CHECK(cmd_movie({dir.string()}) == 2);                // no frames
+  CHECK(cmd_movie({(dir / "missing").string()}) == 2);  // no folder
+  CHECK(cmd_movie({dir.string(), "--fps", "0"}) == 2);  // bad fps
+  fs::create_directories(dir / "frames" / "front");
+  for (int k = 0; k < 3; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%05d.png", k);
+    write_png(dir / "frames" / "front" / name, Image(32, 16, 40 * k, 80, 120));
+  }
+  setenv("AORTASPH_FFMPEG", "/nonexistent/ffmpeg", 1);
+  CHECK(cmd_movie({dir.string()}) == 2);  // ffmpeg missing
+  unsetenv("AORTASPH_FFMPEG");
+  if (std::system("command -v ffmpeg > /dev/null 2>&1") == 0) {
+    CHECK(cmd_movie({dir.string(), "--fps", "10"}) == 0);
+    CHECK(fs::file_size(dir / "frames" / "front.mp4") > 0);
+  }
+}
