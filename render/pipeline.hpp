@@ -29,6 +29,8 @@
 
 namespace aortasph {
 
+class Renderer;
+
 class FramePipeline {
  public:
   // Validates the settings and figures, creates the output folders and starts the render thread; waits until
@@ -55,7 +57,7 @@ class FramePipeline {
 
  private:
   void thread_main(std::promise<void>* ready);
-  void render_one(class Renderer& renderer, const Snapshot& snapshot);
+  void render_one(Renderer& renderer, const Snapshot& snapshot);
   void fail(const std::string& message);
   void write_figures();
 

@@ -93,6 +93,7 @@ struct Renderer::Impl {
   GLuint ms_fbo = 0, ms_color = 0, ms_depth = 0, resolve_fbo = 0, resolve_color = 0;
   float max_point_size = 64.0f;
   std::vector<SplatVertex> splats;  // reused between frames
+  std::vector<uint8_t> rows;        // read-back buffer, reused
 
   explicit Impl(const RenderSettings& s) : settings(s), colormap(s.colormap), range(s.range) {
     splat_program = build_program("shaders/splat.vert.glsl", shaders::splat_vert_glsl,
@@ -123,7 +124,9 @@ struct Renderer::Impl {
     glEnableVertexAttribArray(0);
 
     const int w = settings.width, h = settings.height;
-    const int samples = msaa_samples();
+    GLint max_samples = 1;
+    glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+    const int samples = std::min(msaa_samples(), static_cast<int>(max_samples));
     glGenFramebuffers(1, &ms_fbo);
     glGenRenderbuffers(1, &ms_color);
     glGenRenderbuffers(1, &ms_depth);
@@ -387,15 +390,22 @@ struct Renderer::Impl {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
     glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo);
-    Image image(w, h);
-    std::vector<uint8_t> rows(static_cast<size_t>(w) * h * 3);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glReadPixels(0, 0, w, h, GL_RGB, GL_UNSIGNED_BYTE, rows.data());
+    // RGBA is the framebuffer's own layout, so llvmpipe copies it directly (GL_RGB takes a per-pixel
+    // conversion path, measured slower); dropping alpha and flipping rows happen in one pass here.
+    rows.resize(static_cast<size_t>(w) * h * 4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rows.data());
     check_gl("drawing a frame");
-    const size_t stride = static_cast<size_t>(w) * 3;
-    for (int y = 0; y < h; ++y)
-      std::memcpy(image.rgb.data() + static_cast<size_t>(y) * stride,
-                  rows.data() + static_cast<size_t>(h - 1 - y) * stride, stride);
+    Image image(w, h);
+    for (int y = 0; y < h; ++y) {
+      const uint8_t* src = rows.data() + static_cast<size_t>(h - 1 - y) * w * 4;
+      uint8_t* dst = image.at(0, y);
+      for (int x = 0; x < w; ++x, src += 4, dst += 3) {
+        dst[0] = src[0];
+        dst[1] = src[1];
+        dst[2] = src[2];
+      }
+    }
     return image;
   }
 };

@@ -4,9 +4,8 @@
 // render == Surface are drawn as their translucent, two-sided lit mesh instead of their particles; Hidden
 // bodies are not drawn. Colour is the body colour (color_by == "material") or the snapshot's field through
 // the colormap, with one range for the whole run. The clip plane removes the +normal half of the listed
-// bodies. Anti-aliasing: a 4x multisampled framebuffer with alpha-to-coverage on the splat rims (measured
-// cost in render_bench; 4x is the sweet spot on llvmpipe: 8x roughly doubles the fill cost for little visible
-// gain).
+// bodies. Anti-aliasing: a 4x multisampled framebuffer with alpha-to-coverage on the splat rims (smooth
+// silhouettes without shading every sample; llvmpipe offers at most 4 samples).
 #pragma once
 
 #include <memory>

@@ -1,5 +1,4 @@
 #version 330 core
-#extension GL_ARB_conservative_depth : enable
 // Sphere impostor: reconstructs the sphere's surface inside the point sprite, lights it and writes the true
 // depth of that surface, so splats intersect each other and the wall meshes correctly.
 flat in vec3 v_center;
@@ -16,7 +15,6 @@ uniform float u_specular;
 uniform float u_shininess;
 
 out vec4 frag_color;
-layout(depth_greater) out float gl_FragDepth;
 
 void main() {
   // Offset from the exact projected centre, not gl_PointCoord: rasterisers may snap a sprite's size and

@@ -20,12 +20,6 @@ void main() {
   v_center = view.xyz;
   v_color = a_color.rgb;
   gl_Position = u_proj * view;
-  // The sprite's own depth is that of the sphere's front point, the nearest the impostor can be: the fragment
-  // shader only ever moves depth backwards from there (declared with depth_greater), which lets the rasteriser
-  // reject hidden fragments early.
-  vec4 front = u_proj * vec4(view.xy, view.z + u_radius, 1.0);
-  gl_Position.z = front.z / front.w * gl_Position.w;
-  // Diameter in pixels: 2 r / w scales NDC units (2 per viewport height) by proj[1][1].
   float w = max(gl_Position.w, 1e-6);
   float diameter = u_radius * u_proj[1][1] * u_viewport.y / w;
   // Two pixels of slack so the anti-aliased rim always gets fragments, whatever rounding of the sprite size

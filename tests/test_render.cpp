@@ -8,11 +8,14 @@
 // by far (proved by the "deliberate change" test). To regenerate the goldens after an intended change, run
 //   AORTASPH_UPDATE_GOLDEN=1 ./aortasph_tests "[render]"
 // look at the new tests/golden/*.png, and commit them.
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 
 #include "colormap.hpp"
 #include "figure.hpp"
@@ -48,12 +51,20 @@ ImageDiff check_golden(const std::string& name, const Image& image) {
   return d;
 }
 
-fs::path scratch_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("aortasph_test_render_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+// A fresh folder under the system temp folder, removed again at the end of the test case. The process id
+// keeps concurrent test runs (e.g. two build trees) apart.
+struct ScratchDir {
+  fs::path path;
+  explicit ScratchDir(const std::string& name)
+      : path(fs::temp_directory_path() / ("aortasph_test_render_" + std::to_string(getpid()) + "_" + name)) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
 
 RenderSettings small_settings(int w, int h) {
   RenderSettings s;
@@ -178,8 +189,8 @@ TEST_CASE("render: one splat centred in view has the lit colour and a centred, s
   // sphere's normal n at each pixel centre (the image centre is a pixel corner, so the four pixels around it
   // are checked).
   const float* L = Lighting::kLightDir;
-  const double f = 1.0 / std::tan(17.5 * M_PI / 180.0);  // proj[1][1]
-  const double half_px = 0.25 * f * 64 / 2.0 / 2.0;      // r * proj11 * height / distance / 2
+  const double f = 1.0 / std::tan(17.5 * std::numbers::pi / 180.0);  // proj[1][1]
+  const double half_px = 0.25 * f * 64 / 2.0 / 2.0;                  // r * proj11 * height / distance / 2
   const double hn = std::sqrt(L[0] * L[0] + L[1] * L[1] + (L[2] + 1.0) * (L[2] + 1.0));
   for (int y : {31, 32})
     for (int x : {31, 32}) {
@@ -346,7 +357,10 @@ TEST_CASE("render: bad input raises RenderError with a clear message", "[render]
   Renderer renderer(s);
   CHECK_THAT(message_of([&] { renderer.render(one_splat(), along_up); }), Catch::Contains("parallel to up"));
   s.cameras.push_back(along_up);
-  CHECK_THAT(message_of([&] { FramePipeline p(s, scratch_dir("bad"), 0.1); }),
+  CHECK_THAT(message_of([&] {
+               ScratchDir dir("bad");
+               FramePipeline p(s, dir.path, 0.1);
+             }),
              Catch::Contains("parallel to up"));
   Snapshot broken = one_splat();
   broken.body = {5};
@@ -371,7 +385,8 @@ TEST_CASE("render: bad input raises RenderError with a clear message", "[render]
 }
 
 TEST_CASE("render: PNG write/read round trip; a failed write leaves no file", "[render]") {
-  const fs::path dir = scratch_dir("png");
+  const ScratchDir scratch("png");
+  const fs::path& dir = scratch.path;
   Image image(6, 4, 10, 20, 30);
   image.at(5, 3)[0] = 255;
   write_png(dir / "a.png", image);
@@ -384,7 +399,8 @@ TEST_CASE("render: PNG write/read round trip; a failed write leaves no file", "[
 }
 
 TEST_CASE("render: frame pipeline writes numbered frames and an even-sized figure", "[render]") {
-  const fs::path out = scratch_dir("pipeline");
+  const ScratchDir scratch("pipeline");
+  const fs::path& out = scratch.path;
   RenderSettings settings = small_settings(96, 64);
   settings.color_by = "speed";
   settings.cameras = {front_camera(3.35), composite_camera()};
@@ -421,7 +437,8 @@ TEST_CASE("render: frame pipeline writes numbered frames and an even-sized figur
 TEST_CASE("render: a render-thread error stops the pipeline with a message", "[render]") {
   RenderSettings settings = small_settings(32, 32);
   settings.cameras = {front_camera()};
-  FramePipeline pipeline(settings, scratch_dir("pipeline_error"), 0.1);
+  const ScratchDir scratch("pipeline_error");
+  FramePipeline pipeline(settings, scratch.path, 0.1);
   Snapshot bad = one_splat();
   bad.body = {7};  // a body that does not exist
   bool threw = false;
@@ -455,7 +472,8 @@ TEST_CASE("render: figure sheet composition labels panels and adds a colour bar"
 }
 
 TEST_CASE("render: compare command exit codes and messages", "[render]") {
-  const fs::path dir = scratch_dir("compare");
+  const ScratchDir scratch("compare");
+  const fs::path& dir = scratch.path;
   Image a(8, 8, 100, 100, 100), b = a, c(8, 6, 0, 0, 0);
   b.at(3, 3)[1] = 104;
   write_png(dir / "a.png", a);
@@ -483,7 +501,8 @@ TEST_CASE("render: compare command exit codes and messages", "[render]") {
 }
 
 TEST_CASE("render: movie command", "[render]") {
-  const fs::path dir = scratch_dir("movie");
+  const ScratchDir scratch("movie");
+  const fs::path& dir = scratch.path;
   CHECK(cmd_movie({dir.string()}) == 2);                // no frames
   CHECK(cmd_movie({(dir / "missing").string()}) == 2);  // no folder
   CHECK(cmd_movie({dir.string(), "--fps", "0"}) == 2);  // bad fps
@@ -500,4 +519,41 @@ TEST_CASE("render: movie command", "[render]") {
     CHECK(cmd_movie({dir.string(), "--fps", "10"}) == 0);
     CHECK(fs::file_size(dir / "frames" / "front.mp4") > 0);
   }
+}
+
+TEST_CASE("render: a short scene run gives identical frames for 1 and 2 threads, matching the golden",
+          "[render]") {
+  const ScratchDir scratch("run");
+  const fs::path scene = scratch.path / "tiny_cubes.json";
+  // Two small water cubes flying at each other (the fluid_cubes scene, scaled down to 2 x 216 particles).
+  std::ofstream(scene) << R"({
+  "name": "tiny_cubes",
+  "domain": { "min": [-1, -1, -1], "max": [1, 1, 1] },
+  "resolution": { "spacing": 0.01, "smoothing_ratio": 1.3 },
+  "time": { "end": 0.01, "output_interval": 0.005, "cfl": 0.25, "max_dt": 1e-3 },
+  "gravity": [0, 0, 0],
+  "materials": { "water": { "type": "fluid", "density": 1000, "viscosity": 1e-6, "sound_speed": 20 } },
+  "bodies": [
+    { "name": "left", "material": "water", "shape": { "box": { "min": [-0.07, -0.03, -0.03], "max": [-0.01, 0.03, 0.03] } },
+      "velocity": [1, 0, 0], "color": [0.2, 0.45, 0.9] },
+    { "name": "right", "material": "water", "shape": { "box": { "min": [0.01, -0.01, -0.03], "max": [0.07, 0.05, 0.03] } },
+      "velocity": [-1, 0, 0], "color": [0.9, 0.35, 0.25] }
+  ],
+  "render": {
+    "width": 96, "height": 64, "background": [1, 1, 1], "color_by": "material",
+    "cameras": [ { "name": "oblique", "eye": [0.07, 0.08, 0.17], "target": [0, 0.01, 0], "up": [0, 1, 0], "fov_deg": 40 } ]
+  }
+})";
+  for (const std::string threads : {"1", "2"}) {
+    const std::string cmd = std::string(AORTASPH_BINARY) + " run " + scene.string() + " --quiet --threads " +
+                            threads + " --out " + (scratch.path / ("t" + threads)).string() +
+                            " > /dev/null 2>&1";
+    REQUIRE(std::system(cmd.c_str()) == 0);
+  }
+  const fs::path frames1 = scratch.path / "t1" / "frames" / "oblique",
+                 frames2 = scratch.path / "t2" / "frames" / "oblique";
+  CHECK(png_names(frames1) ==
+        std::vector<std::string>{"frame_00000.png", "frame_00001.png", "frame_00002.png"});
+  CHECK(cmd_compare({frames1.string(), frames2.string()}) == 0);  // bitwise identical (tolerance 0)
+  check_golden("render_run.png", read_png(frames1 / "frame_00002.png"));
 }
