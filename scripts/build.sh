@@ -6,3 +6,4 @@ dir=${1:-build}
 shift || true
 cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "$@" > /dev/null
 cmake --build "$dir" -j "$(nproc)"
+ln -sf app/aortasph "$dir/aortasph"
