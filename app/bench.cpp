@@ -1,11 +1,11 @@
-// aortasph bench: a standard dam break (about 100k fluid particles, or 12k with --quick) stepped a fixed number of
-// times; prints fluid particle-steps per second, neighbours per particle, bytes per particle and the per-phase
-// profile, and writes bench.json. Speed is measured here, never in unit tests.
+// aortasph bench: a standard dam break (about 100k fluid particles, or 12k with --quick) stepped a fixed
+// number of times; prints fluid particle-steps per second, neighbours per particle, bytes per particle and
+// the per-phase profile, and writes bench.json. Speed is measured here, never in unit tests.
 #include <chrono>
 #include <cstdio>
 #include <fstream>
-#include <iostream>
 #include <iomanip>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"

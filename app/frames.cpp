@@ -12,7 +12,8 @@ class PipelineSink : public FrameSink {
   PipelineSink(const Scene& scene, const std::filesystem::path& out_dir)
       : field_(scene.render.color_by), pipeline_(scene.render, out_dir, scene.output_interval) {}
 
-  // The snapshot is copied here, on the simulation thread; drawing and PNG encoding happen on the render thread.
+  // The snapshot is copied here, on the simulation thread; drawing and PNG encoding happen on the render
+  // thread.
   void push(const World& world, int frame) override {
     if (pipeline_.failed()) throw InputError("rendering failed: " + pipeline_.error());
     try {

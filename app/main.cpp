@@ -1,5 +1,5 @@
-// aortasph: the command line (SPEC.md section 1). Dispatches to the subcommands and maps errors to exit codes:
-// 2 bad input, 3 unstable simulation, 1 images differ (compare), 130 interrupted.
+// aortasph: the command line (SPEC.md section 1). Dispatches to the subcommands and maps errors to exit
+// codes: 2 bad input, 3 unstable simulation, 1 images differ (compare), 130 interrupted.
 #include <cstdio>
 #include <exception>
 #include <string>

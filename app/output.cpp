@@ -62,7 +62,8 @@ void VtkWriter::write(const World& world, int frame) {
   for (std::size_t i = 0; i < n; ++i) f << P.body[i] << '\n';
   f << "</DataArray>\n<DataArray type=\"Int32\" Name=\"id\" format=\"ascii\">\n";
   for (std::size_t i = 0; i < n; ++i) f << P.id[i] << '\n';
-  f << "</DataArray>\n</PointData>\n<Verts>\n<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n";
+  f << "</DataArray>\n</PointData>\n<Verts>\n<DataArray type=\"Int32\" Name=\"connectivity\" "
+       "format=\"ascii\">\n";
   for (std::size_t i = 0; i < n; ++i) f << i << '\n';
   f << "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
   for (std::size_t i = 0; i < n; ++i) f << i + 1 << '\n';

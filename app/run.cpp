@@ -15,12 +15,12 @@
 
 #include "commands.hpp"
 #include "errors.hpp"
-#include "sim_errors.hpp"
 #include "frames.hpp"
 #include "output.hpp"
 #include "parallel.hpp"
 #include "probes.hpp"
 #include "scene_loader.hpp"
+#include "sim_errors.hpp"
 #include "world.hpp"
 
 namespace aortasph {
@@ -28,7 +28,9 @@ namespace aortasph {
 namespace {
 
 std::atomic<bool> g_interrupted{false};
-extern "C" void on_sigint(int) { g_interrupted = true; }
+extern "C" void on_sigint(int) {
+  g_interrupted = true;
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -79,8 +81,8 @@ class Progress {
       const int decile = static_cast<int>(std::floor(frac * 10.0 + 1e-9));
       if (decile <= decile_) return;
       decile_ = decile;
-      std::fprintf(stderr, "  %3d %%  t = %.4f s  steps %ld  dt %.2e s  particles %zu  wall %s\n", decile * 10,
-                   w.time(), w.steps(), w.last_dt(), w.particles().size(), hms(wall).c_str());
+      std::fprintf(stderr, "  %3d %%  t = %.4f s  steps %ld  dt %.2e s  particles %zu  wall %s\n",
+                   decile * 10, w.time(), w.steps(), w.last_dt(), w.particles().size(), hms(wall).c_str());
     }
   }
   void done() {
@@ -96,7 +98,8 @@ class Progress {
 };
 
 std::vector<std::string> diagnostics_columns() {
-  std::vector<std::string> cols = {"steps", "dt", "particles", "fluid", "boundary", "max_speed", "max_density_error"};
+  std::vector<std::string> cols = {"steps",    "dt",        "particles",        "fluid",
+                                   "boundary", "max_speed", "max_density_error"};
   for (const auto& [name, sec] : Profile{}.phases()) cols.push_back("wall_" + name);
   cols.push_back("wall_total");
   return cols;
@@ -105,7 +108,7 @@ std::vector<std::string> diagnostics_columns() {
 std::vector<double> diagnostics_row(const World& w) {
   const double n = static_cast<double>(w.particles().size());
   const double fluid = static_cast<double>(w.count(Kind::Fluid));
-  std::vector<double> row = {w.time(),     static_cast<double>(w.steps()), w.last_dt(), n, fluid, n - fluid,
+  std::vector<double> row = {w.time(),      static_cast<double>(w.steps()), w.last_dt(), n, fluid, n - fluid,
                              w.max_speed(), w.max_density_error()};
   for (const auto& [name, sec] : w.profile().phases()) row.push_back(sec);
   row.push_back(w.profile().total());
@@ -139,18 +142,24 @@ RunOptions parse_run_options(const std::vector<std::string>& args) {
       if (k + 1 >= args.size()) throw InputError(a + ": missing value");
       return args[++k];
     };
-    if (a == "--out") o.out = value();
+    if (a == "--out")
+      o.out = value();
     else if (a == "--threads") {
       o.threads = parse_int(a, value());
       if (o.threads < 1 || o.threads > 1024) throw InputError("--threads: expected 1..1024, got " + args[k]);
     } else if (a == "--end-time") {
       o.end_time = parse_double(a, value());
       if (*o.end_time <= 0) throw InputError("--end-time: must be positive, got " + args[k]);
-    } else if (a == "--set") o.sets.push_back(value());
-    else if (a == "--no-render") o.no_render = true;
-    else if (a == "--vtk") o.vtk = true;
-    else if (a == "--quiet") o.quiet = true;
-    else if (!a.empty() && a[0] == '-') throw InputError(a + ": unknown option (see aortasph --help)");
+    } else if (a == "--set")
+      o.sets.push_back(value());
+    else if (a == "--no-render")
+      o.no_render = true;
+    else if (a == "--vtk")
+      o.vtk = true;
+    else if (a == "--quiet")
+      o.quiet = true;
+    else if (!a.empty() && a[0] == '-')
+      throw InputError(a + ": unknown option (see aortasph --help)");
     else if (!have_scene) {
       o.scene = a;
       have_scene = true;
@@ -186,8 +195,8 @@ int cmd_run(const RunOptions& o) {
 
   if (!o.quiet)
     std::fprintf(stderr, "aortasph: %s: %zu particles (%zu fluid), h = %g m, %d thread(s) -> %s\n",
-                 scene.name.c_str(), world.particles().size(), world.count(Kind::Fluid), world.kernel().h, threads,
-                 dir.string().c_str());
+                 scene.name.c_str(), world.particles().size(), world.count(Kind::Fluid), world.kernel().h,
+                 threads, dir.string().c_str());
 
   int frame = 0;
   auto output = [&]() {
@@ -243,7 +252,8 @@ int cmd_run(const RunOptions& o) {
     progress.done();
     if (frames) frames->finish();
     if (g_interrupted) {
-      std::fprintf(stderr, "aortasph: interrupted at t = %g s; everything written so far is valid\n", world.time());
+      std::fprintf(stderr, "aortasph: interrupted at t = %g s; everything written so far is valid\n",
+                   world.time());
       write_run_json("interrupted", "");
       code = 130;
     } else {
@@ -273,9 +283,9 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
   const Scene& scene = loaded.scene;
   const World world(scene);
   std::printf("scene %s: spacing %g m, h = %g m (ratio %g), domain [%g %g %g] .. [%g %g %g]\n",
-              scene.name.c_str(), scene.spacing, world.kernel().h, scene.smoothing_ratio, scene.domain.min.x(),
-              scene.domain.min.y(), scene.domain.min.z(), scene.domain.max.x(), scene.domain.max.y(),
-              scene.domain.max.z());
+              scene.name.c_str(), scene.spacing, world.kernel().h, scene.smoothing_ratio,
+              scene.domain.min.x(), scene.domain.min.y(), scene.domain.min.z(), scene.domain.max.x(),
+              scene.domain.max.y(), scene.domain.max.z());
   std::printf("  %-20s %-12s %-8s %10s\n", "body", "material", "type", "particles");
   static const char* kTypes[] = {"fluid", "elastic", "rigid", "wall"};
   for (const BodyInfo& b : world.bodies())
@@ -287,10 +297,11 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
   const double dt = world.stable_dt();
   const double steps = std::ceil(scene.t_end / dt);
   const double neighbors = n ? static_cast<double>(world.neighbors().pairs()) / static_cast<double>(n) : 0.0;
-  std::printf("  dt estimate %.3g s (cfl %g, max_dt %g), about %.0f steps to t = %g s, %.0f neighbours/particle\n",
-              dt, scene.cfl, scene.max_dt, steps, scene.t_end, neighbors);
-  // Cost model: about 1e6 moving-particle-steps per second on 2 cores at ~80 neighbours (aortasph bench); fixed
-  // wall particles cost about a tenth of a moving one. A first guess: the dt adapts during the run.
+  std::printf(
+      "  dt estimate %.3g s (cfl %g, max_dt %g), about %.0f steps to t = %g s, %.0f neighbours/particle\n",
+      dt, scene.cfl, scene.max_dt, steps, scene.t_end, neighbors);
+  // Cost model: about 1e6 moving-particle-steps per second on 2 cores at ~80 neighbours (aortasph bench);
+  // fixed wall particles cost about a tenth of a moving one. A first guess: the dt adapts during the run.
   const double moving = static_cast<double>(n - world.count(Kind::Wall));
   const double walls = static_cast<double>(world.count(Kind::Wall));
   const double particle_steps = steps * (moving + 0.1 * walls);
@@ -299,8 +310,8 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
               particle_steps, hms(particle_steps / (0.5e6 * threads)).c_str(), threads,
               static_cast<double>(world.memory_bytes()) / 1e6);
   std::printf("  outputs: %ld (every %g s), probes: %zu, cameras: %zu\n",
-              static_cast<long>(std::floor(scene.t_end / scene.output_interval + 1e-9)) + 1, scene.output_interval,
-              scene.probes.size(), scene.render.cameras.size());
+              static_cast<long>(std::floor(scene.t_end / scene.output_interval + 1e-9)) + 1,
+              scene.output_interval, scene.probes.size(), scene.render.cameras.size());
   return 0;
 }
 

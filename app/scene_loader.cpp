@@ -23,16 +23,24 @@ std::string type_name(const json& j) {
   return "null";
 }
 
-[[noreturn]] void fail(const std::string& path, const std::string& what) { throw InputError(path + ": " + what); }
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw InputError(path + ": " + what);
+}
 
-std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
-std::string index(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
+std::string join(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
+std::string index(const std::string& path, std::size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
 
 // Reads one JSON object: checks its type, that it has no unknown key (typos are errors), fills defaults into
-// the JSON (so the resolved scene in run.json is complete) and records the keys an object may have, for --set.
+// the JSON (so the resolved scene in run.json is complete) and records the keys an object may have, for
+// --set.
 class Obj {
  public:
-  Obj(json& j, std::string path, std::vector<std::string> keys, std::map<std::string, std::set<std::string>>& allowed)
+  Obj(json& j, std::string path, std::vector<std::string> keys,
+      std::map<std::string, std::set<std::string>>& allowed)
       : j_(j), path_(std::move(path)) {
     if (!j_.is_object()) fail(path_.empty() ? "scene" : path_, "expected an object, got " + type_name(j_));
     for (auto it = j_.begin(); it != j_.end(); ++it)
@@ -76,7 +84,8 @@ class Obj {
   int integer(const std::string& key, std::optional<int> def, int lo, int hi) {
     const double d = number(key, def ? std::optional<double>(*def) : std::nullopt);
     if (d != std::floor(d) || d < lo || d > hi)
-      fail(path(key), "expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + json(d).dump());
+      fail(path(key), "expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " +
+                          json(d).dump());
     return static_cast<int>(d);
   }
   bool boolean(const std::string& key, bool def) {
@@ -92,7 +101,8 @@ class Obj {
     if (!j_[key].is_string()) fail(path(key), "expected a string, got " + type_name(j_[key]));
     return j_[key].get<std::string>();
   }
-  std::string choice(const std::string& key, std::vector<std::string> options, std::optional<std::string> def = std::nullopt) {
+  std::string choice(const std::string& key, std::vector<std::string> options,
+                     std::optional<std::string> def = std::nullopt) {
     const std::string s = string(key, def);
     if (std::find(options.begin(), options.end(), s) == options.end()) {
       std::string list;
@@ -132,10 +142,12 @@ class Obj {
     Box b{vec3(lo_key), vec3(hi_key)};
     for (int d = 0; d < 3; ++d)
       if (!(b.min[d] < b.max[d]))
-        fail(path(hi_key), "must be greater than " + lo_key + " in every component (component " + std::to_string(d) + ")");
+        fail(path(hi_key),
+             "must be greater than " + lo_key + " in every component (component " + std::to_string(d) + ")");
     return b;
   }
-  std::vector<std::string> strings(const std::string& key, std::optional<std::vector<std::string>> def = std::nullopt) {
+  std::vector<std::string> strings(const std::string& key,
+                                   std::optional<std::vector<std::string>> def = std::nullopt) {
     if (!j_.contains(key)) {
       if (!def) fail(path(key), "missing (expected a list of strings)");
       j_[key] = *def;
@@ -161,7 +173,10 @@ class Loader {
 
   Scene load(json& root) {
     Scene s;
-    Obj top(root, "", {"name", "description", "domain", "resolution", "time", "gravity", "materials", "contact", "bodies", "probes", "render"}, allowed);
+    Obj top(root, "",
+            {"name", "description", "domain", "resolution", "time", "gravity", "materials", "contact",
+             "bodies", "probes", "render"},
+            allowed);
     s.name = top.string("name");
     if (s.name.empty() || s.name.find('/') != std::string::npos || s.name == "." || s.name == "..")
       fail("name", "must be a non-empty name without '/'");
@@ -175,9 +190,11 @@ class Loader {
     Obj res(top.raw("resolution"), "resolution", {"spacing", "smoothing_ratio"}, allowed);
     s.spacing = res.positive("spacing");
     s.smoothing_ratio = res.number("smoothing_ratio", 1.3);
-    if (s.smoothing_ratio < 1.0 || s.smoothing_ratio > 3.0) fail(res.path("smoothing_ratio"), "must lie in 1..3");
+    if (s.smoothing_ratio < 1.0 || s.smoothing_ratio > 3.0)
+      fail(res.path("smoothing_ratio"), "must lie in 1..3");
 
-    Obj time(top.raw("time"), "time", {"end", "output_interval", "cfl", "max_dt", "max_speed", "fixed_dt"}, allowed);
+    Obj time(top.raw("time"), "time", {"end", "output_interval", "cfl", "max_dt", "max_speed", "fixed_dt"},
+             allowed);
     s.t_end = time.positive("end");
     s.output_interval = time.positive("output_interval");
     s.cfl = time.positive("cfl", 0.25);
@@ -200,10 +217,12 @@ class Loader {
 
     json& bodies = top.raw("bodies");
     if (!bodies.is_array() || bodies.empty()) fail("bodies", "expected a non-empty list of bodies");
-    for (std::size_t b = 0; b < bodies.size(); ++b) s.bodies.push_back(body(bodies[b], index("bodies", b), s));
+    for (std::size_t b = 0; b < bodies.size(); ++b)
+      s.bodies.push_back(body(bodies[b], index("bodies", b), s));
     for (std::size_t b = 0; b < s.bodies.size(); ++b)
       for (std::size_t c = 0; c < b; ++c)
-        if (s.bodies[b].name == s.bodies[c].name) fail(index("bodies", b) + ".name", "duplicate body name '" + s.bodies[b].name + "'");
+        if (s.bodies[b].name == s.bodies[c].name)
+          fail(index("bodies", b) + ".name", "duplicate body name '" + s.bodies[b].name + "'");
     if (s.bodies.size() > 60000) fail("bodies", "too many bodies");
 
     if (!top.has("probes")) root["probes"] = json::array();
@@ -212,7 +231,8 @@ class Loader {
     for (std::size_t p = 0; p < probes.size(); ++p) {
       s.probes.push_back(probe(probes[p], index("probes", p), s));
       for (std::size_t q = 0; q < p; ++q)
-        if (s.probes[q].name == s.probes[p].name) fail(index("probes", p) + ".name", "duplicate probe name '" + s.probes[p].name + "'");
+        if (s.probes[q].name == s.probes[p].name)
+          fail(index("probes", p) + ".name", "duplicate probe name '" + s.probes[p].name + "'");
     }
     if (top.has("render")) render(top.raw("render"), s);
     return s;
@@ -224,16 +244,31 @@ class Loader {
     for (auto it = j.begin(); it != j.end(); ++it) {
       const std::string path = "materials." + it.key();
       if (!it.value().is_object()) fail(path, "expected an object, got " + type_name(it.value()));
-      const std::string type = it.value().contains("type") && it.value()["type"].is_string() ? it.value()["type"].get<std::string>() : "";
-      if (!it.value().contains("type")) fail(path + ".type", "missing (expected fluid, elastic, rigid or wall)");
+      const std::string type = it.value().contains("type") && it.value()["type"].is_string()
+                                   ? it.value()["type"].get<std::string>()
+                                   : "";
+      if (!it.value().contains("type"))
+        fail(path + ".type", "missing (expected fluid, elastic, rigid or wall)");
       if (type != "fluid" && type != "elastic" && type != "rigid" && type != "wall")
-        fail(path + ".type", "unknown value " + it.value()["type"].dump() + " (expected one of: fluid, elastic, rigid, wall)");
+        fail(path + ".type", "unknown value " + it.value()["type"].dump() +
+                                 " (expected one of: fluid, elastic, rigid, wall)");
       Material m;
       m.name = it.key();
       std::vector<std::string> keys = {"type"};
-      if (type == "fluid") keys = {"type", "density", "viscosity", "sound_speed", "eos_exponent", "delta_sph", "artificial_viscosity", "density_summation", "background_pressure"};
-      else if (type == "elastic") keys = {"type", "density", "youngs_modulus", "poisson_ratio", "hourglass", "artificial_viscosity"};
-      else if (type == "rigid") keys = {"type", "density"};
+      if (type == "fluid")
+        keys = {"type",
+                "density",
+                "viscosity",
+                "sound_speed",
+                "eos_exponent",
+                "delta_sph",
+                "artificial_viscosity",
+                "density_summation",
+                "background_pressure"};
+      else if (type == "elastic")
+        keys = {"type", "density", "youngs_modulus", "poisson_ratio", "hourglass", "artificial_viscosity"};
+      else if (type == "rigid")
+        keys = {"type", "density"};
       Obj o(it.value(), path, keys, allowed);
       o.choice("type", {"fluid", "elastic", "rigid", "wall"});
       if (type == "fluid") {
@@ -278,7 +313,10 @@ class Loader {
   }
 
   Body body(json& j, const std::string& path, const Scene& s) {
-    Obj o(j, path, {"name", "material", "shape", "translate", "rotate", "velocity", "angular_velocity", "color", "render", "fixed"}, allowed);
+    Obj o(j, path,
+          {"name", "material", "shape", "translate", "rotate", "velocity", "angular_velocity", "color",
+           "render", "fixed"},
+          allowed);
     Body b;
     b.name = o.string("name");
     if (b.name.empty()) fail(o.path("name"), "must not be empty");
@@ -294,7 +332,9 @@ class Loader {
     b.angular_velocity = o.vec3("angular_velocity", Vec3::Zero());
     if (o.has("color")) b.color = o.color("color");
     const std::string mode = o.choice("render", {"particles", "surface", "hidden"}, "particles");
-    b.render = mode == "surface" ? RenderMode::Surface : mode == "hidden" ? RenderMode::Hidden : RenderMode::Particles;
+    b.render = mode == "surface"  ? RenderMode::Surface
+               : mode == "hidden" ? RenderMode::Hidden
+                                  : RenderMode::Particles;
     if (o.has("fixed")) {
       json& f = o.raw("fixed");
       if (f.is_object() && f.contains("box")) {
@@ -312,9 +352,12 @@ class Loader {
   }
 
   Shape shape(json& j, const std::string& path, double dx) {
-    static const std::vector<std::string> kinds = {"box", "sphere", "cylinder", "container", "tube", "aortic_root", "mesh"};
+    static const std::vector<std::string> kinds = {"box",  "sphere",      "cylinder", "container",
+                                                   "tube", "aortic_root", "mesh"};
     Obj o(j, path, kinds, allowed);
-    if (j.size() != 1) fail(path, "expected exactly one shape (one of box, sphere, cylinder, container, tube), got " + std::to_string(j.size()));
+    if (j.size() != 1)
+      fail(path, "expected exactly one shape (one of box, sphere, cylinder, container, tube), got " +
+                     std::to_string(j.size()));
     const std::string kind = j.begin().key();
     Shape sh;
     const std::string p = o.path(kind);
@@ -329,8 +372,10 @@ class Loader {
       sh.radius = b.positive("radius");
     } else if (kind == "cylinder" || kind == "tube") {
       const bool tube = kind == "tube";
-      Obj b(o.raw(kind), p, tube ? std::vector<std::string>{"base", "axis", "radius", "length", "layers"}
-                                 : std::vector<std::string>{"base", "axis", "radius", "length"}, allowed);
+      Obj b(o.raw(kind), p,
+            tube ? std::vector<std::string>{"base", "axis", "radius", "length", "layers"}
+                 : std::vector<std::string>{"base", "axis", "radius", "length"},
+            allowed);
       sh.kind = tube ? ShapeKind::Tube : ShapeKind::Cylinder;
       sh.base = b.vec3("base");
       sh.axis = b.unit("axis");
@@ -345,17 +390,23 @@ class Loader {
       sh.open = b.strings("open", std::vector<std::string>{});
       for (std::size_t k = 0; k < sh.open.size(); ++k) {
         static const std::set<std::string> faces = {"+x", "-x", "+y", "-y", "+z", "-z"};
-        if (!faces.count(sh.open[k])) fail(index(b.path("open"), k), "unknown face '" + sh.open[k] + "' (expected +x, -x, +y, -y, +z or -z)");
+        if (!faces.count(sh.open[k]))
+          fail(index(b.path("open"), k),
+               "unknown face '" + sh.open[k] + "' (expected +x, -x, +y, -y, +z or -z)");
       }
     } else {
       fail(p, "shape '" + kind + "' is not supported yet");
     }
     // A lattice of more than about 200 million points would exhaust memory long before it ran.
     Vec3 extent = Vec3::Zero();
-    if (sh.kind == ShapeKind::Box || sh.kind == ShapeKind::Container) extent = sh.box.max - sh.box.min + Vec3::Constant(2 * sh.layers * dx);
-    else extent = Vec3::Constant(2 * (sh.radius + sh.layers * dx) + sh.length);
+    if (sh.kind == ShapeKind::Box || sh.kind == ShapeKind::Container)
+      extent = sh.box.max - sh.box.min + Vec3::Constant(2 * sh.layers * dx);
+    else
+      extent = Vec3::Constant(2 * (sh.radius + sh.layers * dx) + sh.length);
     const double cells = (extent / dx).array().ceil().prod();
-    if (cells > 2e8) fail(p, "holds about " + json(cells).dump() + " lattice points at spacing " + json(dx).dump() + ": too many particles");
+    if (cells > 2e8)
+      fail(p, "holds about " + json(cells).dump() + " lattice points at spacing " + json(dx).dump() +
+                  ": too many particles");
     return sh;
   }
 
@@ -372,13 +423,16 @@ class Loader {
     Obj o(j, path, keys, allowed);
     Probe p;
     p.name = o.string("name");
-    if (p.name.empty() || p.name.find_first_of(",\"\n") != std::string::npos) fail(o.path("name"), "must be a non-empty name without commas or quotes");
-    o.choice("type", {"extent", "pressure", "body", "point", "energy", "momentum", "flow_rate", "orifice_area"});
+    if (p.name.empty() || p.name.find_first_of(",\"\n") != std::string::npos)
+      fail(o.path("name"), "must be a non-empty name without commas or quotes");
+    o.choice("type",
+             {"extent", "pressure", "body", "point", "energy", "momentum", "flow_rate", "orifice_area"});
     if (type == "extent") {
       p.type = ProbeType::Extent;
       const auto names = o.strings("bodies");
       if (names.empty()) fail(o.path("bodies"), "expected at least one body");
-      for (std::size_t k = 0; k < names.size(); ++k) p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
+      for (std::size_t k = 0; k < names.size(); ++k)
+        p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
       const std::string axis = o.choice("axis", {"x", "y", "z"});
       p.axis = axis[0] - 'x';
       p.stat_max = o.choice("stat", {"max", "min"}) == "max";
@@ -415,14 +469,18 @@ class Loader {
   }
 
   void render(json& j, Scene& s) {
-    Obj o(j, "render", {"width", "height", "background", "color_by", "colormap", "range", "cameras", "clip", "figures"}, allowed);
+    Obj o(j, "render",
+          {"width", "height", "background", "color_by", "colormap", "range", "cameras", "clip", "figures"},
+          allowed);
     RenderSettings& r = s.render;
     r.width = o.integer("width", 1280, 2, 16384);
     r.height = o.integer("height", 720, 2, 16384);
-    if (r.width % 2 || r.height % 2) fail(o.path(r.width % 2 ? "width" : "height"), "must be even (movies need even sizes)");
+    if (r.width % 2 || r.height % 2)
+      fail(o.path(r.width % 2 ? "width" : "height"), "must be even (movies need even sizes)");
     if (!o.has("background")) j["background"] = {1.0, 1.0, 1.0};
     r.background = o.color("background");
-    r.color_by = o.choice("color_by", {"material", "speed", "pressure", "displacement", "stress"}, "material");
+    r.color_by =
+        o.choice("color_by", {"material", "speed", "pressure", "displacement", "stress"}, "material");
     r.colormap = o.string("colormap", "viridis");
     if (o.has("range")) {
       const json& v = o.raw("range");
@@ -438,7 +496,8 @@ class Loader {
       Obj co(cams[c], index("render.cameras", c), {"name", "eye", "target", "up", "fov_deg"}, allowed);
       Camera cam;
       cam.name = co.string("name");
-      if (cam.name.empty() || cam.name.find('/') != std::string::npos) fail(co.path("name"), "must be a non-empty name without '/'");
+      if (cam.name.empty() || cam.name.find('/') != std::string::npos)
+        fail(co.path("name"), "must be a non-empty name without '/'");
       for (const Camera& other : r.cameras)
         if (other.name == cam.name) fail(co.path("name"), "duplicate camera name '" + cam.name + "'");
       cam.eye = co.vec3("eye");
@@ -447,7 +506,8 @@ class Loader {
       cam.fov_deg = co.number("fov_deg", 35.0);
       if (cam.fov_deg <= 1 || cam.fov_deg >= 179) fail(co.path("fov_deg"), "must lie in (1, 179) degrees");
       if ((cam.eye - cam.target).norm() < 1e-12) fail(co.path("target"), "must differ from eye");
-      if ((cam.eye - cam.target).normalized().cross(cam.up).norm() < 1e-6) fail(co.path("up"), "is parallel to the viewing direction");
+      if ((cam.eye - cam.target).normalized().cross(cam.up).norm() < 1e-6)
+        fail(co.path("up"), "is parallel to the viewing direction");
       r.cameras.push_back(cam);
     }
     if (o.has("clip")) {
@@ -456,7 +516,8 @@ class Loader {
       clip.point = co.vec3("point");
       clip.normal = co.unit("normal");
       const auto names = co.strings("bodies", std::vector<std::string>{});
-      for (std::size_t k = 0; k < names.size(); ++k) clip.bodies.push_back(body_index(s, names[k], index(co.path("bodies"), k)));
+      for (std::size_t k = 0; k < names.size(); ++k)
+        clip.bodies.push_back(body_index(s, names[k], index(co.path("bodies"), k)));
       r.clip = clip;
     }
     if (!o.has("figures")) j["figures"] = json::array();
@@ -466,9 +527,11 @@ class Loader {
       Obj fo(figs[f], index("render.figures", f), {"name", "camera", "times", "columns"}, allowed);
       Figure fig;
       fig.name = fo.string("name");
-      if (fig.name.empty() || fig.name.find('/') != std::string::npos) fail(fo.path("name"), "must be a non-empty name without '/'");
+      if (fig.name.empty() || fig.name.find('/') != std::string::npos)
+        fail(fo.path("name"), "must be a non-empty name without '/'");
       fig.camera = fo.string("camera");
-      if (std::none_of(r.cameras.begin(), r.cameras.end(), [&](const Camera& c) { return c.name == fig.camera; }))
+      if (std::none_of(r.cameras.begin(), r.cameras.end(),
+                       [&](const Camera& c) { return c.name == fig.camera; }))
         fail(fo.path("camera"), "unknown camera '" + fig.camera + "'");
       const json& t = fo.raw("times");
       if (!t.is_array() || t.empty()) fail(fo.path("times"), "expected a non-empty list of times");
@@ -484,8 +547,10 @@ class Loader {
   }
 };
 
-// Applies one --set KEY=VALUE to the JSON. A key may be new only where the loader allows it (an optional key).
-void apply_override(json& root, const std::string& item, const std::map<std::string, std::set<std::string>>& allowed) {
+// Applies one --set KEY=VALUE to the JSON. A key may be new only where the loader allows it (an optional
+// key).
+void apply_override(json& root, const std::string& item,
+                    const std::map<std::string, std::set<std::string>>& allowed) {
   const auto eq = item.find('=');
   if (eq == std::string::npos || eq == 0) throw InputError("--set " + item + ": expected KEY=VALUE");
   const std::string key = item.substr(0, eq), text = item.substr(eq + 1);
@@ -510,7 +575,8 @@ void apply_override(json& root, const std::string& item, const std::map<std::str
         throw InputError("--set " + item + ": '" + part + "' is not a list index (at '" + path + "')");
       }
       if (i >= node->size())
-        throw InputError("--set " + item + ": index " + part + " out of range ('" + path + "' has " + std::to_string(node->size()) + " entries)");
+        throw InputError("--set " + item + ": index " + part + " out of range ('" + path + "' has " +
+                         std::to_string(node->size()) + " entries)");
       path = index(path, i);
       node = &(*node)[i];
     } else if (node->is_object()) {
@@ -519,11 +585,14 @@ void apply_override(json& root, const std::string& item, const std::map<std::str
       if (!node->contains(part)) {
         const auto it = allowed.find(here);
         const bool known = it != allowed.end() && it->second.count(part);
-        if (!known || !last) throw InputError("--set " + item + ": unknown path '" + key + "' (no '" + part + "' at '" + (here.empty() ? "scene" : here) + "')");
+        if (!known || !last)
+          throw InputError("--set " + item + ": unknown path '" + key + "' (no '" + part + "' at '" +
+                           (here.empty() ? "scene" : here) + "')");
       }
       node = &(*node)[part];
     } else {
-      throw InputError("--set " + item + ": unknown path '" + key + "' ('" + path + "' is a value, not an object or list)");
+      throw InputError("--set " + item + ": unknown path '" + key + "' ('" + path +
+                       "' is a value, not an object or list)");
     }
   }
   *node = value;
@@ -531,7 +600,8 @@ void apply_override(json& root, const std::string& item, const std::map<std::str
 
 }  // namespace
 
-LoadedScene load_scene_json(const nlohmann::json& j, const std::vector<std::string>& overrides, const std::filesystem::path&) {
+LoadedScene load_scene_json(const nlohmann::json& j, const std::vector<std::string>& overrides,
+                            const std::filesystem::path&) {
   // First pass: validate the file as written, fill in defaults, learn which optional keys each object allows.
   json filled = j;
   Loader first;

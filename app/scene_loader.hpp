@@ -1,4 +1,5 @@
-// Scene files (SPEC.md section 2): JSON -> validated Scene. Every error names the JSON path of the value at fault
+// Scene files (SPEC.md section 2): JSON -> validated Scene. Every error names the JSON path of the value at
+// fault
 // ("bodies[2].shape.box.max: expected 3 numbers, got 2") and is thrown as InputError (exit code 2) before
 // anything is simulated.
 #pragma once

@@ -4,7 +4,8 @@
 
 namespace aortasph {
 
-void boundary_from_fluid(Particles& P, const NeighborSearch& nb, const FluidContext& ctx, const FluidParams& ref) {
+void boundary_from_fluid(Particles& P, const NeighborSearch& nb, const FluidContext& ctx,
+                         const FluidParams& ref) {
   const auto& idx = nb.index();
   parallel_for_dynamic(P.size(), [&](std::size_t w) {
     if (P.kind[w] == Kind::Fluid) return;

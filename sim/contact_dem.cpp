@@ -27,8 +27,8 @@ Vec3 contact_force(const ContactParams& c, const Vec3& xij, const Vec3& vij) {
   return f;
 }
 
-void contact_forces(const Particles& P, const NeighborSearch& nb, const ContactParams& c, std::vector<Vec3>& f,
-                    std::vector<Vec3>& moment) {
+void contact_forces(const Particles& P, const NeighborSearch& nb, const ContactParams& c,
+                    std::vector<Vec3>& f, std::vector<Vec3>& moment) {
   if (c.k <= 0.0) return;
   const auto& idx = nb.index();
   const double d2 = c.distance * c.distance;

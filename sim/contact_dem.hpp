@@ -9,8 +9,8 @@
 //     glues bodies together, which is not what colliding solids do;
 //   - the shear force is capped by Coulomb friction, |F_t| <= mu F_n: without the cap a fast sliding contact
 //     would grip with any force, and rolling bodies would stop dead.
-// Pairs of particles of one body never contact (a rigid body holds itself together; an elastic body through its
-// own stress), and neither do fluid particles (they interact through pressure).
+// Pairs of particles of one body never contact (a rigid body holds itself together; an elastic body through
+// its own stress), and neither do fluid particles (they interact through pressure).
 #pragma once
 
 #include "neighbors.hpp"
@@ -32,10 +32,10 @@ Vec3 contact_force(const ContactParams& c, const Vec3& xij, const Vec3& vij);
 
 // Adds to f[i] the contact forces on every non-fluid particle i (gathered over its neighbours), and to
 // moment[i] their moment about x_i when each acts at the contact point, midway between the two centres:
-// sum_j (x_j - x_i) / 2 x F_ij. A rigid body's torque sum then uses the contact points, so a pair's two forces
-// have equal and opposite moments and angular momentum is conserved (with forces at the particle centres the
-// shear force of eq. 25 would create angular momentum from nothing).
-void contact_forces(const Particles& P, const NeighborSearch& nb, const ContactParams& c, std::vector<Vec3>& f,
-                    std::vector<Vec3>& moment);
+// sum_j (x_j - x_i) / 2 x F_ij. A rigid body's torque sum then uses the contact points, so a pair's two
+// forces have equal and opposite moments and angular momentum is conserved (with forces at the particle
+// centres the shear force of eq. 25 would create angular momentum from nothing).
+void contact_forces(const Particles& P, const NeighborSearch& nb, const ContactParams& c,
+                    std::vector<Vec3>& f, std::vector<Vec3>& moment);
 
 }  // namespace aortasph

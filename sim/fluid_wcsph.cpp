@@ -74,17 +74,22 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
 
 namespace {
 
-// Acceleration of fluid particle i due to particle j (fluid or boundary): one term of the sums of eqs. (9) and
-// (10) plus artificial viscosity. Zero beyond the kernel support. The same function gives the reaction on a
-// moving boundary particle, so the force a body receives is exactly minus what the fluid feels.
-// What the pair terms need of particle i, loaded once per particle rather than once per pair.
+// Acceleration of fluid particle i due to particle j (fluid or boundary): one term of the sums of eqs. (9)
+// and (10) plus artificial viscosity. Zero beyond the kernel support. The same function gives the reaction on
+// a moving boundary particle, so the force a body receives is exactly minus what the fluid feels. What the
+// pair terms need of particle i, loaded once per particle rather than once per pair.
 struct FluidI {
   std::size_t i;
   Vec3 x, v;
   double rho, p_over_rho2;
   const FluidParams* params;
   FluidI(const Particles& P, const FluidContext& ctx, std::size_t i)
-      : i(i), x(P.x[i]), v(P.v[i]), rho(P.rho[i]), p_over_rho2(ctx.p_over_rho2[i]), params(&ctx.params[P.material[i]]) {}
+      : i(i),
+        x(P.x[i]),
+        v(P.v[i]),
+        rho(P.rho[i]),
+        p_over_rho2(ctx.p_over_rho2[i]),
+        params(&ctx.params[P.material[i]]) {}
 };
 
 struct PairConstants {
@@ -93,8 +98,8 @@ struct PairConstants {
       : h(K.h), eta2(0.01 * K.h * K.h), support2(K.support * K.support) {}  // 0.01 h^2 of eq. (10)
 };
 
-inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx, const PairConstants& c, const FluidI& I,
-                              std::size_t j) {
+inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx, const PairConstants& c,
+                              const FluidI& I, std::size_t j) {
   const Vec3 xij = I.x - P.x[j];
   const double r2 = xij.squaredNorm();
   if (r2 >= c.support2 || r2 <= 0.0) return Vec3::Zero();  // Verlet-list pairs in the skin
@@ -125,9 +130,9 @@ inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx, const
   Vec3 acc = (mj * scalar) * gradW;
 
   // Viscosity, eq. (10), in the form symmetric in i and j (Morris, Fox & Zhu 1997, eq. 8): 2/rho_j becomes
-  // 1/rho_i + 1/rho_j, equal to eq. (10) at uniform density and exactly momentum conserving. Boundary particles
-  // use their extrapolated no-slip velocity (Adami et al. 2012, eq. 22): a moving wall's velocity enters the
-  // viscous force here.
+  // 1/rho_i + 1/rho_j, equal to eq. (10) at uniform density and exactly momentum conserving. Boundary
+  // particles use their extrapolated no-slip velocity (Adami et al. 2012, eq. 22): a moving wall's velocity
+  // enters the viscous force here.
   const double nu = fluid_j ? 0.5 * (fi.nu + ctx.params[P.material[j]].nu) : fi.nu;
   if (nu > 0.0) {
     const Vec3 vij_visc = fluid_j ? vij : Vec3(I.v - P.v_wall[j]);
@@ -151,7 +156,8 @@ void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ct
   });
 }
 
-void fluid_reaction(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx, std::vector<Vec3>& f) {
+void fluid_reaction(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx,
+                    std::vector<Vec3>& f) {
   const auto& idx = nb.index();
   const PairConstants c(ctx.kernel);
   parallel_for_dynamic(P.size(), [&](std::size_t j) {

@@ -3,7 +3,8 @@
 //   pressure gradient in the symmetric form (eq. 9), Laplacian viscosity (eq. 10), gravity.
 // Stabilisers, each switchable per material in the scene:
 //   - density diffusion ("delta-SPH"): Molteni & Colagrossi 2009, Comput. Phys. Commun. 180:861, with the
-//     hydrostatic correction of Fourtakas et al. 2019, Comput. Fluids 190:346 (so a fluid at rest stays at rest);
+//     hydrostatic correction of Fourtakas et al. 2019, Comput. Fluids 190:346 (so a fluid at rest stays at
+//     rest);
 //   - artificial viscosity: Monaghan 1992, Annu. Rev. Astron. Astrophys. 30:543, eq. (4.2).
 // Boundary particles (walls, later rigid and elastic bodies) enter the sums through the values the wall
 // boundary (boundary.hpp) gives them: pressure, density and a no-slip velocity.
@@ -42,9 +43,7 @@ struct FluidParams {
   FluidParams() = default;
 
   // Tait equation, eq. (13): p = k ((rho / rho0)^gamma - 1).
-  double pressure(double rho) const {
-    return B * (std::pow(rho / rho0, gamma) - 1.0) + p_background;
-  }
+  double pressure(double rho) const { return B * (std::pow(rho / rho0, gamma) - 1.0) + p_background; }
   // Its inverse, for boundary particles that receive a pressure.
   double density(double p) const {
     return rho0 * std::pow(std::max((p - p_background) / B + 1.0, 1e-6), 1.0 / gamma);
@@ -76,9 +75,10 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
 // Gathers: each fluid particle writes only its own a.
 void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ctx);
 
-// Adds to f[j], for every moving boundary particle j (rigid, elastic), the force the fluid exerts on it: minus
-// the sum of m_i a_ij over its fluid neighbours i, with the very pair terms of fluid_forces (Newton's third law;
-// Adami et al. 2012 section 2.4).
-void fluid_reaction(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx, std::vector<Vec3>& f);
+// Adds to f[j], for every moving boundary particle j (rigid, elastic), the force the fluid exerts on it:
+// minus the sum of m_i a_ij over its fluid neighbours i, with the very pair terms of fluid_forces (Newton's
+// third law; Adami et al. 2012 section 2.4).
+void fluid_reaction(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx,
+                    std::vector<Vec3>& f);
 
 }  // namespace aortasph

@@ -40,7 +40,10 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std:
   // Grid over the particles' bounding box. The cell count is capped at a few per particle so that a
   // sparse scene (two bodies far apart) cannot exhaust memory; bigger cells stay correct, only slower.
   const BoundsAcc box = parallel_reduce(
-      n, BoundsAcc{}, [&](std::size_t i) { return BoundsAcc{x[i], x[i]}; },
+      n, BoundsAcc{},
+      [&](std::size_t i) {
+        return BoundsAcc{x[i], x[i]};
+      },
       [](const BoundsAcc& a, const BoundsAcc& b) {
         return BoundsAcc{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)};
       });
@@ -109,7 +112,8 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std:
     for (int z = std::max(cz - kReach, 0); z <= std::min(cz + kReach, dims_[2] - 1); ++z)
       for (int y = std::max(cy - kReach, 0); y <= std::min(cy + kReach, dims_[1] - 1); ++y) {
         const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
-        if (fixed_i && std::none_of(&cell_moving[row + x0], &cell_moving[row + x1] + 1, [](uint8_t m) { return m; }))
+        if (fixed_i &&
+            std::none_of(&cell_moving[row + x0], &cell_moving[row + x1] + 1, [](uint8_t m) { return m; }))
           continue;
         // Cells x-2 .. x+2 of one row are contiguous in cell_items_.
         for (uint32_t k = cell_start_[row + x0]; k < cell_start_[row + x1 + 1]; ++k) {

@@ -1,8 +1,8 @@
 // Cell-linked-list neighbour search (Monaghan & Lattanzio 1985; the "linked list" of Hockney & Eastwood),
 // O(N): particles are binned into cubic cells of half the search radius, and the candidates of particle i are
-// the particles of the 5 x 5 x 5 cells around its own. The result is a compressed row list (CSR): the neighbours of
-// i are index[offset[i] .. offset[i+1]), in a fixed order (cells in z, y, x order, then particle index), so
-// every sum over neighbours is bitwise the same for any thread count.
+// the particles of the 5 x 5 x 5 cells around its own. The result is a compressed row list (CSR): the
+// neighbours of i are index[offset[i] .. offset[i+1]), in a fixed order (cells in z, y, x order, then
+// particle index), so every sum over neighbours is bitwise the same for any thread count.
 #pragma once
 
 #include <cstdint>

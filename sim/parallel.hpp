@@ -1,6 +1,6 @@
 // The one place that says "#pragma omp". Loops gather: iteration i writes only entries of i, so results never
-// depend on the thread count. Reductions sum fixed-size blocks, then combine the block results in block order:
-// the same bits for 1 or 32 threads (the pattern Box2D's determinism test relies on).
+// depend on the thread count. Reductions sum fixed-size blocks, then combine the block results in block
+// order: the same bits for 1 or 32 threads (the pattern Box2D's determinism test relies on).
 #pragma once
 
 #include <omp.h>
@@ -52,7 +52,11 @@ T parallel_reduce(std::size_t n, T identity, Value&& value, Combine&& combine) {
   return total;
 }
 
-inline int max_threads() { return omp_get_max_threads(); }
-inline void set_threads(int n) { omp_set_num_threads(n); }
+inline int max_threads() {
+  return omp_get_max_threads();
+}
+inline void set_threads(int n) {
+  omp_set_num_threads(n);
+}
 
 }  // namespace aortasph

@@ -1,6 +1,6 @@
-// Particle storage as a structure of arrays: hot state (x, v, a, rho, p) in contiguous arrays, so the neighbour
-// loops stream through memory. permute() reorders every per-particle array at once after a spatial sort, so no
-// array can forget to follow.
+// Particle storage as a structure of arrays: hot state (x, v, a, rho, p) in contiguous arrays, so the
+// neighbour loops stream through memory. permute() reorders every per-particle array at once after a spatial
+// sort, so no array can forget to follow.
 #pragma once
 
 #include <cstdint>
@@ -14,16 +14,16 @@ enum class Kind : uint8_t { Fluid = 0, Wall = 1, Rigid = 2, Elastic = 3 };
 
 struct Particles {
   // Hot state.
-  std::vector<Vec3> x;        // position [m]
-  std::vector<Vec3> v;        // velocity [m/s]
-  std::vector<Vec3> a;        // acceleration of this step [m/s^2]
-  std::vector<double> rho;    // density [kg/m^3] (walls: extrapolated, Adami et al. 2012)
-  std::vector<double> drho;   // d rho / dt of this step
-  std::vector<double> p;      // pressure [Pa]
-  std::vector<Vec3> v_wall;   // walls: extrapolated velocity for the no-slip condition (Adami et al. 2012)
+  std::vector<Vec3> x;       // position [m]
+  std::vector<Vec3> v;       // velocity [m/s]
+  std::vector<Vec3> a;       // acceleration of this step [m/s^2]
+  std::vector<double> rho;   // density [kg/m^3] (walls: extrapolated, Adami et al. 2012)
+  std::vector<double> drho;  // d rho / dt of this step
+  std::vector<double> p;     // pressure [Pa]
+  std::vector<Vec3> v_wall;  // walls: extrapolated velocity for the no-slip condition (Adami et al. 2012)
   // Cold state.
-  std::vector<double> m;      // mass [kg]
-  std::vector<Vec3> x0;       // position at t = 0 (displacement, TL-SPH reference)
+  std::vector<double> m;  // mass [kg]
+  std::vector<Vec3> x0;   // position at t = 0 (displacement, TL-SPH reference)
   std::vector<Kind> kind;
   std::vector<uint16_t> body;      // index into the scene's bodies
   std::vector<uint16_t> material;  // index into the scene's materials

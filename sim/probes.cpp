@@ -3,8 +3,8 @@
 #include <cmath>
 #include <limits>
 
-#include "sim_errors.hpp"
 #include "parallel.hpp"
+#include "sim_errors.hpp"
 
 namespace aortasph {
 
@@ -18,7 +18,8 @@ struct Sum3 {
   Sum3 operator+(const Sum3& o) const { return {a + o.a, b + o.b, m + o.m}; }
 };
 
-void add_columns(std::vector<std::string>& cols, const std::string& name, std::initializer_list<const char*> fields) {
+void add_columns(std::vector<std::string>& cols, const std::string& name,
+                 std::initializer_list<const char*> fields) {
   for (const char* f : fields) cols.push_back(name + "." + f);
 }
 
@@ -32,7 +33,9 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
     switch (pr.type) {
       case ProbeType::Extent:
       case ProbeType::Pressure:
-      case ProbeType::FlowRate: columns_.push_back(pr.name); break;
+      case ProbeType::FlowRate:
+        columns_.push_back(pr.name);
+        break;
       case ProbeType::BodyState:
         add_columns(columns_, pr.name, {"x", "y", "z", "vx", "vy", "vz", "px", "py", "pz"});
         if (world.bodies()[pr.body].rigid >= 0)
@@ -52,11 +55,16 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
             found = true;
           }
         }
-        if (!found) throw SetupError("probes[" + std::to_string(k) + "] '" + pr.name + "': body has no particle");
+        if (!found)
+          throw SetupError("probes[" + std::to_string(k) + "] '" + pr.name + "': body has no particle");
         break;
       }
-      case ProbeType::Energy: add_columns(columns_, pr.name, {"kinetic", "potential", "elastic", "total"}); break;
-      case ProbeType::Momentum: add_columns(columns_, pr.name, {"px", "py", "pz", "lx", "ly", "lz"}); break;
+      case ProbeType::Energy:
+        add_columns(columns_, pr.name, {"kinetic", "potential", "elastic", "total"});
+        break;
+      case ProbeType::Momentum:
+        add_columns(columns_, pr.name, {"px", "py", "pz", "lx", "ly", "lz"});
+        break;
       case ProbeType::OrificeArea:
         throw SetupError("probes[" + std::to_string(k) + "] '" + pr.name +
                          "': orifice_area needs an elastic valve, which this version cannot simulate yet");
@@ -103,7 +111,9 @@ std::vector<double> ProbeSet::measure(const World& world) const {
               const double W = K.W((P.x[i] - pr.point).norm()) * P.m[i] / P.rho[i];
               return PW{P.p[i] * W, W};
             },
-            [](const PW& a, const PW& b) { return PW{a.pw + b.pw, a.w + b.w}; });
+            [](const PW& a, const PW& b) {
+              return PW{a.pw + b.pw, a.w + b.w};
+            });
         out.push_back(s.w > 0.0 ? s.pw / s.w : kNaN);
         break;
       }
@@ -111,8 +121,8 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         if (const int r = world.bodies()[pr.body].rigid; r >= 0) {
           const RigidBody& b = world.rigid_bodies()[r];
           const Vec3 v = b.velocity(), w = b.omega();
-          out.insert(out.end(), {b.com.x(), b.com.y(), b.com.z(), v.x(), v.y(), v.z(), b.P.x(), b.P.y(), b.P.z(),
-                                 w.x(), w.y(), w.z(), b.q.w(), b.q.x(), b.q.y(), b.q.z()});
+          out.insert(out.end(), {b.com.x(), b.com.y(), b.com.z(), v.x(), v.y(), v.z(), b.P.x(), b.P.y(),
+                                 b.P.z(), w.x(), w.y(), w.z(), b.q.w(), b.q.x(), b.q.y(), b.q.z()});
           break;
         }
         // Centre of mass, its velocity and the body's momentum.
@@ -156,7 +166,9 @@ std::vector<double> ProbeSet::measure(const World& world) const {
               if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid) return E{};
               return E{0.5 * P.m[i] * P.v[i].squaredNorm(), -P.m[i] * g.dot(P.x[i])};
             },
-            [](const E& a, const E& b) { return E{a.kin + b.kin, a.pot + b.pot}; });
+            [](const E& a, const E& b) {
+              return E{a.kin + b.kin, a.pot + b.pot};
+            });
         // Rigid bodies: translation and rotation, eq. (21), and the potential of the centre of mass.
         double kin = e.kin, pot = e.pot;
         for (const RigidBody& b : world.rigid_bodies()) {
@@ -201,7 +213,8 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         out.push_back(q / d);
         break;
       }
-      case ProbeType::OrificeArea: break;  // refused in the constructor
+      case ProbeType::OrificeArea:
+        break;  // refused in the constructor
     }
   }
   return out;

@@ -2,7 +2,8 @@
 
 namespace aortasph {
 
-RigidBody make_rigid_body(int body, const std::vector<Vec3>& x, double m, double dx, const Vec3& v, const Vec3& w) {
+RigidBody make_rigid_body(int body, const std::vector<Vec3>& x, double m, double dx, const Vec3& v,
+                          const Vec3& w) {
   RigidBody b;
   b.body = body;
   b.mass = m * static_cast<double>(x.size());

@@ -19,14 +19,14 @@ using Mat3 = Eigen::Matrix3d;
 struct RigidBody {
   int body = 0;  // index into the scene's bodies
   double mass = 0.0;
-  Vec3 com0 = Vec3::Zero();     // centre of mass at t = 0 (particles' body-frame origin)
+  Vec3 com0 = Vec3::Zero();      // centre of mass at t = 0 (particles' body-frame origin)
   Mat3 inertia0 = Mat3::Zero();  // about the centre of mass, world axes at t = 0
   Mat3 inv_inertia0 = Mat3::Zero();
   // State.
   Vec3 com = Vec3::Zero();
   Eigen::Quaterniond q = Eigen::Quaterniond::Identity();  // body to world
-  Vec3 P = Vec3::Zero();  // linear momentum
-  Vec3 L = Vec3::Zero();  // angular momentum about the centre of mass
+  Vec3 P = Vec3::Zero();                                  // linear momentum
+  Vec3 L = Vec3::Zero();                                  // angular momentum about the centre of mass
   // Sums of the current step.
   Vec3 force = Vec3::Zero();
   Vec3 torque = Vec3::Zero();
@@ -43,10 +43,11 @@ struct RigidBody {
   Vec3 position_of(const Vec3& x0) const { return com + rotation() * (x0 - com0); }
 };
 
-// Mass, centre of mass and inertia tensor of point masses m at x, each also carrying the inertia of its own cube
-// of side dx (m dx^2 / 6 about every axis), so a box of particles has exactly the inertia of the solid box.
-// Initial velocity v and angular velocity w (about the centre of mass).
-RigidBody make_rigid_body(int body, const std::vector<Vec3>& x, double m, double dx, const Vec3& v, const Vec3& w);
+// Mass, centre of mass and inertia tensor of point masses m at x, each also carrying the inertia of its own
+// cube of side dx (m dx^2 / 6 about every axis), so a box of particles has exactly the inertia of the solid
+// box. Initial velocity v and angular velocity w (about the centre of mass).
+RigidBody make_rigid_body(int body, const std::vector<Vec3>& x, double m, double dx, const Vec3& v,
+                          const Vec3& w);
 
 // One step of eqs. (19)-(22) with the force and torque already summed (gravity included): symplectic Euler,
 // P and L first, then the centre of mass and the orientation with the new velocities. The orientation

@@ -1,5 +1,6 @@
 // Scene description: plain, validated values (SPEC.md section 2). No JSON here: app/scene_loader parses
-// and validates the JSON file into these structs; sim/ builds a World from them; render/ reads RenderSettings.
+// and validates the JSON file into these structs; sim/ builds a World from them; render/ reads
+// RenderSettings.
 #pragma once
 
 #include <Eigen/Dense>
@@ -27,10 +28,10 @@ struct Material {
   double density = 1000.0;  // rest density rho0 [kg/m^3] (unused for walls)
 
   // Fluid (weakly compressible SPH, paper section 3.1)
-  double viscosity = 1e-6;      // kinematic viscosity nu [m^2/s], paper eq. (10)
-  double sound_speed = 20.0;    // numerical sound speed c0 [m/s]; Tait k = rho0 c0^2 / gamma
-  double eos_exponent = 7.0;    // gamma in the Tait equation, paper eq. (13)
-  double delta_sph = 0.1;       // density diffusion delta (Antuono et al. 2010); 0 switches it off
+  double viscosity = 1e-6;            // kinematic viscosity nu [m^2/s], paper eq. (10)
+  double sound_speed = 20.0;          // numerical sound speed c0 [m/s]; Tait k = rho0 c0^2 / gamma
+  double eos_exponent = 7.0;          // gamma in the Tait equation, paper eq. (13)
+  double delta_sph = 0.1;             // density diffusion delta (Antuono et al. 2010); 0 switches it off
   double artificial_viscosity = 0.0;  // Monaghan alpha (Monaghan 1992); 0 switches it off
   bool density_summation = false;     // eq. (11) instead of the continuity equation (12)
   double background_pressure = 0.0;   // added to the Tait pressure [Pa]
@@ -38,23 +39,24 @@ struct Material {
   // Elastic (Total-Lagrangian SPH, paper section 3.2)
   double youngs_modulus = 0.0;
   double poisson_ratio = 0.0;
-  double hourglass = 10.0;          // Ganzenmueller 2015 hourglass coefficient
-  double solid_art_viscosity = 1.0; // artificial viscosity alpha for solids
+  double hourglass = 10.0;           // Ganzenmueller 2015 hourglass coefficient
+  double solid_art_viscosity = 1.0;  // artificial viscosity alpha for solids
 };
 
 enum class ShapeKind { Box, Sphere, Cylinder, Container, Tube, AorticRoot, Mesh };
 
 struct Shape {
   ShapeKind kind = ShapeKind::Box;
-  Box box;                      // box, container (inner box)
-  Vec3 center = Vec3::Zero();   // sphere
-  double radius = 0.0;          // sphere, cylinder, tube (inner radius)
-  Vec3 base = Vec3::Zero();     // cylinder, tube: centre of the base disc
-  Vec3 axis = Vec3::UnitY();    // cylinder, tube: unit axis
-  double length = 0.0;          // cylinder, tube
-  int layers = 3;               // container, tube: particle layers outside the surface
-  std::vector<std::string> open;  // container: faces left out, "+x","-x","+y","-y","+z","-z"; tube: "+", "-" ends capped unless open (tube ends are open by default)
-  std::string mesh_file;        // mesh
+  Box box;                        // box, container (inner box)
+  Vec3 center = Vec3::Zero();     // sphere
+  double radius = 0.0;            // sphere, cylinder, tube (inner radius)
+  Vec3 base = Vec3::Zero();       // cylinder, tube: centre of the base disc
+  Vec3 axis = Vec3::UnitY();      // cylinder, tube: unit axis
+  double length = 0.0;            // cylinder, tube
+  int layers = 3;                 // container, tube: particle layers outside the surface
+  std::vector<std::string> open;  // container: faces left out, "+x","-x","+y","-y","+z","-z"; tube: "+", "-"
+                                  // ends capped unless open (tube ends are open by default)
+  std::string mesh_file;          // mesh
 };
 
 enum class RenderMode { Particles, Surface, Hidden };
@@ -70,7 +72,7 @@ struct Body {
   Vec3 angular_velocity = Vec3::Zero();
   std::optional<Vec3> color;  // rgb in 0..1
   RenderMode render = RenderMode::Particles;
-  std::optional<Box> fixed;   // elastic bodies: particles inside are clamped
+  std::optional<Box> fixed;  // elastic bodies: particles inside are clamped
 };
 
 struct Contact {

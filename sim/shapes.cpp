@@ -24,7 +24,8 @@ void lattice(const Vec3& lo, const Vec3& hi, double dx, Keep&& keep, std::vector
 void add_quad(SurfaceMesh& m, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const auto base = static_cast<uint32_t>(m.vertices.size());
   for (const Vec3* v : {&a, &b, &c, &d})
-    m.vertices.push_back({static_cast<float>(v->x()), static_cast<float>(v->y()), static_cast<float>(v->z())});
+    m.vertices.push_back(
+        {static_cast<float>(v->x()), static_cast<float>(v->y()), static_cast<float>(v->z())});
   m.triangles.push_back({base, base + 1, base + 2});
   m.triangles.push_back({base, base + 2, base + 3});
 }
@@ -32,11 +33,14 @@ void add_quad(SurfaceMesh& m, const Vec3& a, const Vec3& b, const Vec3& c, const
 // Faces of a box; skip[f] leaves face f out (order -x, +x, -y, +y, -z, +z). inward flips the winding.
 void box_mesh(const Box& b, const bool skip[6], bool inward, SurfaceMesh& m) {
   const Vec3 lo = b.min, hi = b.max;
-  auto corner = [&](int x, int y, int z) { return Vec3(x ? hi.x() : lo.x(), y ? hi.y() : lo.y(), z ? hi.z() : lo.z()); };
+  auto corner = [&](int x, int y, int z) {
+    return Vec3(x ? hi.x() : lo.x(), y ? hi.y() : lo.y(), z ? hi.z() : lo.z());
+  };
   // Each face listed counter-clockwise seen from outside.
-  const int faces[6][4][3] = {{{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}}, {{1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1}},
-                              {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}}, {{0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0}},
-                              {{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}}, {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}};
+  const int faces[6][4][3] = {
+      {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}}, {{1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1}},
+      {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}}, {{0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0}},
+      {{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}}, {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}}};
   for (int f = 0; f < 6; ++f) {
     if (skip[f]) continue;
     Vec3 v[4];
@@ -55,7 +59,8 @@ void frame(const Vec3& a, Vec3& u, Vec3& v) {
 }
 
 // Side of a cylinder of radius r from base along axis a (length L); inward flips the winding.
-void cylinder_mesh(const Vec3& base, const Vec3& a, double r, double L, bool inward, bool caps, SurfaceMesh& m) {
+void cylinder_mesh(const Vec3& base, const Vec3& a, double r, double L, bool inward, bool caps,
+                   SurfaceMesh& m) {
   Vec3 u, v;
   frame(a, u, v);
   const int seg = 48;
@@ -79,11 +84,15 @@ void cylinder_mesh(const Vec3& base, const Vec3& a, double r, double L, bool inw
 Vec3 shape_center(const Shape& s) {
   switch (s.kind) {
     case ShapeKind::Box:
-    case ShapeKind::Container: return 0.5 * (s.box.min + s.box.max);
-    case ShapeKind::Sphere: return s.center;
+    case ShapeKind::Container:
+      return 0.5 * (s.box.min + s.box.max);
+    case ShapeKind::Sphere:
+      return s.center;
     case ShapeKind::Cylinder:
-    case ShapeKind::Tube: return s.base + 0.5 * s.length * s.axis.normalized();
-    default: return Vec3::Zero();
+    case ShapeKind::Tube:
+      return s.base + 0.5 * s.length * s.axis.normalized();
+    default:
+      return Vec3::Zero();
   }
 }
 
@@ -92,22 +101,25 @@ ShapeSample sample_body(const Body& body, double dx) {
   const Shape& s = body.shape;
   switch (s.kind) {
     case ShapeKind::Box: {
-      lattice(s.box.min, s.box.max, dx, [](const Vec3&) { return true; }, out.points);
+      lattice(
+          s.box.min, s.box.max, dx, [](const Vec3&) { return true; }, out.points);
       const bool none[6] = {};
       box_mesh(s.box, none, false, out.mesh);
       break;
     }
     case ShapeKind::Sphere: {
       const Vec3 r = Vec3::Constant(s.radius);
-      lattice(s.center - r, s.center + r, dx, [&](const Vec3& p) { return (p - s.center).norm() <= s.radius; },
-              out.points);
+      lattice(
+          s.center - r, s.center + r, dx, [&](const Vec3& p) { return (p - s.center).norm() <= s.radius; },
+          out.points);
       // A UV sphere for the surface.
       const int nu = 32, nv = 16;
       for (int j = 0; j < nv; ++j)
         for (int i = 0; i < nu; ++i) {
           auto at = [&](int ii, int jj) {
             const double th = std::numbers::pi * jj / nv, ph = 2 * std::numbers::pi * ii / nu;
-            return Vec3(s.center + s.radius * Vec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)));
+            return Vec3(s.center + s.radius * Vec3(std::sin(th) * std::cos(ph), std::cos(th),
+                                                   std::sin(th) * std::sin(ph)));
           };
           add_quad(out.mesh, at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
         }
@@ -116,11 +128,15 @@ ShapeSample sample_body(const Body& body, double dx) {
     case ShapeKind::Cylinder: {
       const Vec3 a = s.axis.normalized();
       const Vec3 top = s.base + s.length * a;
-      const Vec3 lo = s.base.cwiseMin(top) - Vec3::Constant(s.radius), hi = s.base.cwiseMax(top) + Vec3::Constant(s.radius);
-      lattice(lo, hi, dx, [&](const Vec3& p) {
-        const double t = (p - s.base).dot(a);
-        return t >= 0 && t <= s.length && (p - s.base - t * a).norm() <= s.radius;
-      }, out.points);
+      const Vec3 lo = s.base.cwiseMin(top) - Vec3::Constant(s.radius),
+                 hi = s.base.cwiseMax(top) + Vec3::Constant(s.radius);
+      lattice(
+          lo, hi, dx,
+          [&](const Vec3& p) {
+            const double t = (p - s.base).dot(a);
+            return t >= 0 && t <= s.length && (p - s.base - t * a).norm() <= s.radius;
+          },
+          out.points);
       cylinder_mesh(s.base, a, s.radius, s.length, false, true, out.mesh);
       break;
     }
@@ -136,7 +152,8 @@ ShapeSample sample_body(const Body& body, double dx) {
         if (!open(pos[d])) hi[d] += t;
       }
       // Align the outer lattice with the inner box so the wall continues the fluid's lattice.
-      lattice(lo, hi, dx, [&](const Vec3& p) { return !s.box.contains(p); }, out.points);
+      lattice(
+          lo, hi, dx, [&](const Vec3& p) { return !s.box.contains(p); }, out.points);
       bool skip[6];
       for (int d = 0; d < 3; ++d) {
         skip[2 * d] = open(neg[d]);
@@ -159,20 +176,23 @@ ShapeSample sample_body(const Body& body, double dx) {
           for (int i = -nr; i < nr; ++i) {
             const double x = (i + 0.5) * dx, y = (j + 0.5) * dx;
             const double rr = std::hypot(x, y);
-            if (rr >= s.radius && rr < outer) out.points.push_back(s.base + (k + 0.5) * dx * a + x * u + y * v);
+            if (rr >= s.radius && rr < outer)
+              out.points.push_back(s.base + (k + 0.5) * dx * a + x * u + y * v);
           }
       cylinder_mesh(s.base, a, s.radius, s.length, true, false, out.mesh);
       break;
     }
     case ShapeKind::AorticRoot:
-    case ShapeKind::Mesh: break;  // refused by the scene loader until implemented
+    case ShapeKind::Mesh:
+      break;  // refused by the scene loader until implemented
   }
 
   // Rotation about the shape's centre, then translation.
   if (body.rotate_degrees != 0.0 || body.translate != Vec3::Zero()) {
     const Vec3 c = shape_center(s);
     const Eigen::Matrix3d R =
-        Eigen::AngleAxisd(body.rotate_degrees * std::numbers::pi / 180.0, body.rotate_axis.normalized()).toRotationMatrix();
+        Eigen::AngleAxisd(body.rotate_degrees * std::numbers::pi / 180.0, body.rotate_axis.normalized())
+            .toRotationMatrix();
     for (Vec3& p : out.points) p = c + R * (p - c) + body.translate;
     for (auto& vtx : out.mesh.vertices) {
       const Vec3 p = c + R * (Vec3(vtx[0], vtx[1], vtx[2]) - c) + body.translate;

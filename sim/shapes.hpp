@@ -15,9 +15,9 @@ struct ShapeSample {
 };
 
 // Lattice convention: a box [min, max] holds the centres min + (i + 1/2) dx, so the particles' cubes tile it
-// exactly. Curved shapes keep the lattice points inside them. Container and tube walls lie outside their inner
-// surface, `layers` particles thick. The body's rotation (about the shape's centre) and translation are applied
-// last.
+// exactly. Curved shapes keep the lattice points inside them. Container and tube walls lie outside their
+// inner surface, `layers` particles thick. The body's rotation (about the shape's centre) and translation are
+// applied last.
 ShapeSample sample_body(const Body& body, double spacing);
 
 // Centre about which a shape rotates: the centre of its bounding box before rotation.

@@ -28,13 +28,13 @@ struct BodyView {
 
 struct Snapshot {
   double time = 0.0;
-  int frame = 0;            // output index k: time = k * output_interval
-  double spacing = 0.01;    // particle spacing: splat radius = spacing / 2
-  std::vector<float> position;   // 3 * n, xyz per particle
-  std::vector<uint16_t> body;    // body index per particle (index into bodies)
-  std::vector<float> field;      // n values of render.color_by (empty when color_by == "material")
-  std::string field_name;        // e.g. "speed"
-  std::string field_unit;        // e.g. "m/s"
+  int frame = 0;                // output index k: time = k * output_interval
+  double spacing = 0.01;        // particle spacing: splat radius = spacing / 2
+  std::vector<float> position;  // 3 * n, xyz per particle
+  std::vector<uint16_t> body;   // body index per particle (index into bodies)
+  std::vector<float> field;     // n values of render.color_by (empty when color_by == "material")
+  std::string field_name;       // e.g. "speed"
+  std::string field_unit;       // e.g. "m/s"
   std::vector<BodyView> bodies;
   size_t size() const { return body.size(); }
 };

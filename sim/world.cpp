@@ -7,9 +7,9 @@
 #include <sstream>
 
 #include "boundary.hpp"
-#include "sim_errors.hpp"
 #include "parallel.hpp"
 #include "shapes.hpp"
+#include "sim_errors.hpp"
 
 namespace aortasph {
 
@@ -28,20 +28,28 @@ std::string fmt_vec(const Vec3& v) {
 
 std::array<float, 3> default_color(MaterialType t) {
   switch (t) {
-    case MaterialType::Fluid: return {0.22f, 0.47f, 0.85f};
-    case MaterialType::Wall: return {0.62f, 0.62f, 0.62f};
-    case MaterialType::Rigid: return {0.90f, 0.50f, 0.15f};
-    case MaterialType::Elastic: return {0.30f, 0.70f, 0.35f};
+    case MaterialType::Fluid:
+      return {0.22f, 0.47f, 0.85f};
+    case MaterialType::Wall:
+      return {0.62f, 0.62f, 0.62f};
+    case MaterialType::Rigid:
+      return {0.90f, 0.50f, 0.15f};
+    case MaterialType::Elastic:
+      return {0.30f, 0.70f, 0.35f};
   }
   return {0.5f, 0.5f, 0.5f};
 }
 
 Kind kind_of(MaterialType t) {
   switch (t) {
-    case MaterialType::Fluid: return Kind::Fluid;
-    case MaterialType::Wall: return Kind::Wall;
-    case MaterialType::Rigid: return Kind::Rigid;
-    case MaterialType::Elastic: return Kind::Elastic;
+    case MaterialType::Fluid:
+      return Kind::Fluid;
+    case MaterialType::Wall:
+      return Kind::Wall;
+    case MaterialType::Rigid:
+      return Kind::Rigid;
+    case MaterialType::Elastic:
+      return Kind::Elastic;
   }
   return Kind::Wall;
 }
@@ -76,8 +84,8 @@ World::World(const Scene& scene)
     const Material& mat = scene_.materials.at(body.material);
     const std::string where = "bodies[" + std::to_string(b) + "] '" + body.name + "'";
     if (mat.type == MaterialType::Elastic)
-      throw SetupError(where + ": material '" + mat.name + "' is of type elastic, which this version cannot " +
-                       "simulate yet");
+      throw SetupError(where + ": material '" + mat.name +
+                       "' is of type elastic, which this version cannot " + "simulate yet");
     ShapeSample sample = sample_body(body, dx);
     if (sample.points.empty())
       throw SetupError(where + ": the shape holds no particle at spacing " + std::to_string(dx));
@@ -131,8 +139,8 @@ World::World(const Scene& scene)
     }
     if (mat.type == MaterialType::Rigid) {
       info.rigid = static_cast<int>(rigid_.size());
-      rigid_.push_back(make_rigid_body(static_cast<int>(b), sample.points, mat.density * volume, dx, body.velocity,
-                                       body.angular_velocity));
+      rigid_.push_back(make_rigid_body(static_cast<int>(b), sample.points, mat.density * volume, dx,
+                                       body.velocity, body.angular_velocity));
       // A rigid body answers a contact with its whole mass M, and up to about n^(2/3) of its n particles (one
       // face) can touch at once: the stiffest mode has mass M / n^(2/3) on one spring.
       const double n = static_cast<double>(sample.points.size());
@@ -150,8 +158,9 @@ World::World(const Scene& scene)
     for (uint32_t k = nb_.begin(i); k < nb_.end(i); ++k) {
       const uint32_t j = nb_.index()[k];
       if (P_.body[j] != P_.body[i])
-        throw SetupError("bodies '" + scene_.bodies[P_.body[i]].name + "' and '" + scene_.bodies[P_.body[j]].name +
-                         "' overlap near " + fmt_vec(P_.x[i]) + ": particles closer than half a spacing");
+        throw SetupError("bodies '" + scene_.bodies[P_.body[i]].name + "' and '" +
+                         scene_.bodies[P_.body[j]].name + "' overlap near " + fmt_vec(P_.x[i]) +
+                         ": particles closer than half a spacing");
     }
 
   for (std::size_t i = 0; i < P_.size(); ++i)
@@ -199,10 +208,10 @@ std::vector<uint8_t> World::fixed_mask() const {
 }
 
 // Verlet lists (Verlet 1967): the lists hold every pair closer than the kernel support plus a skin, and are
-// rebuilt only when some particle has moved half a skin since the last build, so no pair within the support can
-// be missing. Pairs between support and support + skin cost a little in every loop (the kernel is zero there)
-// and save most rebuilds. Every few rebuilds the particles are also re-sorted along a Z-order curve of the
-// cells so that neighbours stay close in memory as the flow mixes them.
+// rebuilt only when some particle has moved half a skin since the last build, so no pair within the support
+// can be missing. Pairs between support and support + skin cost a little in every loop (the kernel is zero
+// there) and save most rebuilds. Every few rebuilds the particles are also re-sorted along a Z-order curve of
+// the cells so that neighbours stay close in memory as the flow mixes them.
 void World::update_neighbors() {
   const auto t0 = Clock::now();
   if (!lists_valid_) {
@@ -234,8 +243,8 @@ void World::build_lists() {
 // One time step, Algorithm 1: neighbours -> density -> pressure -> boundary -> forces -> integrate.
 // The density is advanced before the forces are computed, so that the pressure driving v(t + dt) is that of
 // rho(t + dt): with both taken from time t the acoustic modes would grow each step (the explicit Euler scheme
-// is unconditionally unstable for an oscillator); in this order the pair (rho, v) is advanced by the symplectic
-// Euler scheme, as (v, x) is in Algorithm 1 lines 15-16.
+// is unconditionally unstable for an oscillator); in this order the pair (rho, v) is advanced by the
+// symplectic Euler scheme, as (v, x) is in Algorithm 1 lines 15-16.
 void World::step(double dt) {
   update_neighbors();
   FluidContext& ctx = ctx_;
@@ -243,7 +252,7 @@ void World::step(double dt) {
   auto t0 = Clock::now();
   fluid_density_summation(P_, nb_, ctx);  // eq. (11), where a material asks for it
   fluid_pair_terms(P_, ctx);
-  fluid_density_rate(P_, nb_, ctx);       // eq. (12) + diffusion, elsewhere
+  fluid_density_rate(P_, nb_, ctx);  // eq. (12) + diffusion, elsewhere
   parallel_for(P_.size(), [&](std::size_t i) {
     if (P_.kind[i] == Kind::Fluid && !fluid_[P_.material[i]].summation) P_.rho[i] += dt * P_.drho[i];
   });
@@ -297,10 +306,10 @@ void World::integrate(double dt) {
   max_accel_ = std::max(std::sqrt(e.a2), gravity_.norm());
 }
 
-// Rigid bodies, eqs. (19)-(22): per particle the fluid's reaction (equal and opposite to what the fluid feels)
-// and contact forces (eqs. 23-25), summed per body in array order (the same order for any thread count), plus
-// gravity; then each body advances and its particles follow. The particles' acceleration, which the wall
-// boundary needs (Adami et al. 2012, eq. 27), is their change of velocity over the step.
+// Rigid bodies, eqs. (19)-(22): per particle the fluid's reaction (equal and opposite to what the fluid
+// feels) and contact forces (eqs. 23-25), summed per body in array order (the same order for any thread
+// count), plus gravity; then each body advances and its particles follow. The particles' acceleration, which
+// the wall boundary needs (Adami et al. 2012, eq. 27), is their change of velocity over the step.
 void World::step_rigid(double dt) {
   const std::size_t n = P_.size();
   force_.assign(n, Vec3::Zero());
@@ -342,8 +351,9 @@ void World::check_and_remove(double dt) {
   if (bad < n) {
     std::ostringstream msg;
     const bool finite = P_.x[bad].allFinite() && P_.v[bad].allFinite() && std::isfinite(P_.rho[bad]);
-    msg << "unstable at t = " << time_ + dt << " s, step " << steps_ + 1 << " (dt = " << dt << " s): particle "
-        << P_.id[bad] << " of body '" << scene_.bodies[P_.body[bad]].name << "' at " << fmt_vec(P_.x[bad])
+    msg << "unstable at t = " << time_ + dt << " s, step " << steps_ + 1 << " (dt = " << dt
+        << " s): particle " << P_.id[bad] << " of body '" << scene_.bodies[P_.body[bad]].name << "' at "
+        << fmt_vec(P_.x[bad])
         << (finite ? " moves at " + std::to_string(P_.v[bad].norm()) + " m/s, over the limit of " +
                          std::to_string(speed_limit_) + " m/s (time.max_speed)"
                    : " has a non-finite position, velocity or density");
@@ -391,8 +401,8 @@ double World::max_density_error() const {
 }
 
 std::size_t World::memory_bytes() const {
-  const std::size_t per = sizeof(Vec3) * 5 + sizeof(double) * 4 + sizeof(Kind) + 2 * sizeof(uint16_t) +
-                          sizeof(uint32_t);
+  const std::size_t per =
+      sizeof(Vec3) * 5 + sizeof(double) * 4 + sizeof(Kind) + 2 * sizeof(uint16_t) + sizeof(uint32_t);
   return per * P_.x.capacity() + nb_.bytes();
 }
 

@@ -23,11 +23,11 @@ struct Profile {
   double total() const { return neighbors + density + boundary + forces + rigid + integrate + sort; }
   // (name, seconds) of each phase, in step order: the one list that diagnostics, run.json and bench print.
   std::vector<std::pair<std::string, double>> phases() const {
-    return {{"neighbors", neighbors}, {"density", density}, {"boundary", boundary}, {"forces", forces},
+    return {{"neighbors", neighbors}, {"density", density},     {"boundary", boundary}, {"forces", forces},
             {"rigid", rigid},         {"integrate", integrate}, {"sort", sort}};
   }
   Profile operator-(const Profile& o) const {
-    return {neighbors - o.neighbors, density - o.density, boundary - o.boundary, forces - o.forces,
+    return {neighbors - o.neighbors, density - o.density,     boundary - o.boundary, forces - o.forces,
             rigid - o.rigid,         integrate - o.integrate, sort - o.sort};
   }
 };
@@ -36,9 +36,9 @@ struct BodyInfo {
   std::string name;
   MaterialType type = MaterialType::Fluid;
   int material = 0;
-  std::size_t count = 0;   // particles at t = 0
-  int rigid = -1;          // index into World::rigid_bodies() for rigid bodies
-  SurfaceMesh mesh;        // world coordinates at t = 0
+  std::size_t count = 0;  // particles at t = 0
+  int rigid = -1;         // index into World::rigid_bodies() for rigid bodies
+  SurfaceMesh mesh;       // world coordinates at t = 0
 };
 
 class World {
@@ -115,7 +115,7 @@ class World {
   Vec3 gravity_;
   std::vector<FluidParams> fluid_;  // per material (entries of non-fluid materials unused)
   FluidParams wall_ref_;            // equation of state that boundary particles use
-  FluidContext ctx_;  // refers to kernel_ and fluid_; holds per-step scratch arrays
+  FluidContext ctx_;                // refers to kernel_ and fluid_; holds per-step scratch arrays
   Particles P_;
   NeighborSearch nb_;
   std::vector<BodyInfo> bodies_;

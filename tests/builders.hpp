@@ -32,7 +32,8 @@ inline Body box_body(const std::string& name, int material, Vec3 lo, Vec3 hi, Ve
   return b;
 }
 
-inline Body container(const std::string& name, int material, Vec3 lo, Vec3 hi, std::vector<std::string> open) {
+inline Body container(const std::string& name, int material, Vec3 lo, Vec3 hi,
+                      std::vector<std::string> open) {
   Body b;
   b.name = name;
   b.material = material;

@@ -42,7 +42,9 @@ Result aortasph(const std::string& args) {
   return r;
 }
 
-std::string scene_path(const std::string& name) { return std::string(AORTASPH_TEST_DIR) + "/../scenes/" + name; }
+std::string scene_path(const std::string& name) {
+  return std::string(AORTASPH_TEST_DIR) + "/../scenes/" + name;
+}
 
 fs::path write_file(const fs::path& dir, const std::string& name, const std::string& text) {
   const fs::path p = dir / name;
@@ -102,9 +104,11 @@ TEST_CASE("cli: bad input exits 2 with a message naming the problem", "[cli][bad
       {"unknown --set path", kGood, "--set resolution.spacin=0.004", "resolution.spacin"},
       {"--set index out of range", kGood, "--set bodies.5.velocity=[1,0,0]", "bodies"},
       {"unknown material", replace(kGood, "\"material\": \"water\"", "\"material\": \"blood\""), "", "blood"},
-      {"empty body", replace(kGood, "\"max\": [0.05, 0.1, 0.03]", "\"max\": [0.001, 0.1, 0.03]"), "", "column"},
-      {"overlapping bodies", replace(kGood, "\"min\": [0, 0, 0], \"max\": [0.05", "\"min\": [-0.02, 0, 0], \"max\": [0.05"),
-       "", "overlap"},
+      {"empty body", replace(kGood, "\"max\": [0.05, 0.1, 0.03]", "\"max\": [0.001, 0.1, 0.03]"), "",
+       "column"},
+      {"overlapping bodies",
+       replace(kGood, "\"min\": [0, 0, 0], \"max\": [0.05", "\"min\": [-0.02, 0, 0], \"max\": [0.05"), "",
+       "overlap"},
       {"unwritable --out", kGood, "--out /proc/aortasph_cannot_write", "/proc/aortasph_cannot_write"},
       {"bad --threads", kGood, "--threads zero", "--threads"},
       {"unknown option", kGood, "--fast", "--fast"},
@@ -131,8 +135,8 @@ TEST_CASE("cli: probes.csv is bitwise identical for --threads 1 and 2", "[cli][d
   for (int t = 1; t <= 2; ++t) {
     const fs::path out = dir / ("t" + std::to_string(t));
     const Result r = aortasph("run " + scene_path("dam_break.json") + " --quiet --no-render --end-time 0.02" +
-                              " --set resolution.spacing=0.0057 --threads " + std::to_string(t) +
-                              " --out " + out.string());
+                              " --set resolution.spacing=0.0057 --threads " + std::to_string(t) + " --out " +
+                              out.string());
     INFO(r.err);
     REQUIRE(r.code == 0);
     csv[t - 1] = slurp(out / "probes.csv");
@@ -141,7 +145,8 @@ TEST_CASE("cli: probes.csv is bitwise identical for --threads 1 and 2", "[cli][d
   CHECK(csv[0] == csv[1]);
 }
 
-TEST_CASE("cli: an unstable run exits 3, names time and particle, keeps the rows written", "[cli][unstable]") {
+TEST_CASE("cli: an unstable run exits 3, names time and particle, keeps the rows written",
+          "[cli][unstable]") {
   const fs::path dir = scratch("unstable");
   // A time step forced 30 times beyond the acoustic CFL limit (time.fixed_dt bypasses the adaptive step).
   const fs::path scene = write_file(dir, "scene.json", replace(kGood, "\"end\": 0.002", "\"end\": 0.5"));

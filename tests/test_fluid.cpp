@@ -72,8 +72,8 @@ TEST_CASE("colliding fluid cubes conserve linear and angular momentum", "[fluid]
   const double dp = (t1.p - t0.p).norm() / t0.pmag;
   INFO("relative linear momentum change " << dp);
   CHECK(dp < 1e-10);
-  // Angular momentum: central pair forces (pressure, artificial viscosity) conserve it exactly; the viscous term
-  // of eq. (10) is along v_ij, not x_ij, and changes L by O(nu): a tolerance of 1e-6 of sum |x| |m v|.
+  // Angular momentum: central pair forces (pressure, artificial viscosity) conserve it exactly; the viscous
+  // term of eq. (10) is along v_ij, not x_ij, and changes L by O(nu): a tolerance of 1e-6 of sum |x| |m v|.
   const double Lscale = t0.pmag * 0.2;
   const double dL = (t1.L - t0.L).norm() / Lscale;
   INFO("relative angular momentum change " << dL);
@@ -93,7 +93,8 @@ TEST_CASE("a fluid run is bitwise identical for 1 and 2 threads", "[fluid][deter
   CHECK(hashes[0] == hashes[1]);
 }
 
-TEST_CASE("a water column at rest: hydrostatic pressure, no leak, flat surface", "[fluid][hydrostatic][validation]") {
+TEST_CASE("a water column at rest: hydrostatic pressure, no leak, flat surface",
+          "[fluid][hydrostatic][validation]") {
   const double dx = 0.01, H = 0.2;
   Scene s;
   s.name = "hydrostatic_test";
@@ -161,12 +162,12 @@ std::vector<std::pair<double, double>> read_reference(const std::string& file) {
 
 }  // namespace
 
-// Martin & Moyce (1952) surge front, n^2 = 2, against their tabulated data (a = 2.25 in), at the resolution the
-// test suite affords: a / 10 (800 fluid particles in a slab 4 particles deep). The simulated front runs ahead
-// of the experiment early on: +12 to +13 % for T = 1.2 to 1.8 (the experiment's gate and bottom friction slow
-// it; finer resolution does not close the gap, see docs/validation.md). This MISSES the issue's 10 % target for
-// T < 2.3; the test asserts the 10 % band from T = 2.3 to 3 and pins the early lead below 14 %, so that any
-// change that moves the front either way is caught.
+// Martin & Moyce (1952) surge front, n^2 = 2, against their tabulated data (a = 2.25 in), at the resolution
+// the test suite affords: a / 10 (800 fluid particles in a slab 4 particles deep). The simulated front runs
+// ahead of the experiment early on: +12 to +13 % for T = 1.2 to 1.8 (the experiment's gate and bottom
+// friction slow it; finer resolution does not close the gap, see docs/validation.md). This MISSES the issue's
+// 10 % target for T < 2.3; the test asserts the 10 % band from T = 2.3 to 3 and pins the early lead below 14
+// %, so that any change that moves the front either way is caught.
 TEST_CASE("dam break surge front follows Martin & Moyce", "[fluid][validation]") {
   const auto data = read_reference("dambreak_martin_moyce_tables_n2_2_a225in_front.csv");
   REQUIRE(data.size() >= 10);

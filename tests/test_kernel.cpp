@@ -22,9 +22,9 @@ std::vector<Vec3> lattice(double dx, int half, Vec3 shift = Vec3::Zero()) {
 }  // namespace
 
 // The lattice sum of eq. (5) at h = 1.3 dx is 0.997262 (computed independently with a 5-line Python sum): the
-// issue's target |sum - 1| < 1e-3 is missed by the kernel itself, not by this code (the sum oscillates with h/dx:
-// 1.2 -> 1.00081, 1.4 -> 0.99897, 2.0 -> 1.00008). So the test pins the exact value and checks < 1e-3 where the
-// kernel reaches it.
+// issue's target |sum - 1| < 1e-3 is missed by the kernel itself, not by this code (the sum oscillates with
+// h/dx: 1.2 -> 1.00081, 1.4 -> 0.99897, 2.0 -> 1.00008). So the test pins the exact value and checks < 1e-3
+// where the kernel reaches it.
 TEST_CASE("cubic spline sums to one on a lattice", "[kernel]") {
   const double dx = 0.01;
   auto lattice_sum = [&](double ratio, const Vec3& shift, Vec3* grad_out) {
@@ -53,7 +53,7 @@ TEST_CASE("cubic spline sums to one on a lattice", "[kernel]") {
 TEST_CASE("cubic spline is symmetric, positive, compact and its gradient antisymmetric", "[kernel]") {
   const CubicSpline K(0.013);
   const double alpha = 3.0 / (2.0 * std::numbers::pi * std::pow(0.013, 3));
-  CHECK(K.W(0.0) == Approx(alpha * 2.0 / 3.0));  // eq. (5) at q = 0
+  CHECK(K.W(0.0) == Approx(alpha * 2.0 / 3.0));                   // eq. (5) at q = 0
   CHECK(K.W(2.0 * K.h) == Approx(0.0).margin(1e-12 * K.W(0.0)));  // 2h * (1/h) may round just below 2
   CHECK(K.W(2.0001 * K.h) == 0.0);
   CHECK(K.W(2.5 * K.h) == 0.0);
@@ -63,7 +63,7 @@ TEST_CASE("cubic spline is symmetric, positive, compact and its gradient antisym
   for (int t = 0; t < 1000; ++t) {
     const Vec3 xij(u(rng), u(rng), u(rng));
     const double r = xij.norm();
-    CHECK(K.W(r) >= 0.0);                         // eq. (8)
+    CHECK(K.W(r) >= 0.0);  // eq. (8)
     const Vec3 g1 = K.gradW(xij, r), g2 = K.gradW(Vec3(-xij), r);
     CHECK((g1 + g2).norm() == 0.0);               // exactly antisymmetric: pair forces cancel bit for bit
     if (r >= 2.0 * K.h) CHECK(g1.norm() == 0.0);  // compact support

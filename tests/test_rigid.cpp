@@ -88,8 +88,8 @@ TEST_CASE("torque-free rotation keeps |L| and energy, a tilted spin precesses", 
     for (int j = 0; j < 6; ++j)
       for (int k = 0; k < 3; ++k) box.push_back(0.01 * Vec3(i, j, k));
   // Spin about a principal axis (the box's y axis).
-  // About z, the axis of largest inertia (a spin about the intermediate axis y would be unstable: any round-off
-  // grows, the tennis-racket effect).
+  // About z, the axis of largest inertia (a spin about the intermediate axis y would be unstable: any
+  // round-off grows, the tennis-racket effect).
   RigidBody b = make_rigid_body(0, box, 1.0, 0.01, Vec3::Zero(), Vec3(0, 0, 5));
   const double L0 = b.L.norm(), E0 = b.kinetic_energy();
   for (int k = 0; k < 10000; ++k) advance_rigid_body(b, 1e-3);
@@ -106,7 +106,8 @@ TEST_CASE("torque-free rotation keeps |L| and energy, a tilted spin precesses", 
   double max_turn = 0.0;
   for (int k = 0; k < 10000; ++k) {
     advance_rigid_body(t, 1e-4);
-    max_turn = std::max(max_turn, std::acos(std::clamp(t.omega().normalized().dot(w0.normalized()), -1.0, 1.0)));
+    max_turn =
+        std::max(max_turn, std::acos(std::clamp(t.omega().normalized().dot(w0.normalized()), -1.0, 1.0)));
   }
   CHECK((t.L - Lt).norm() == 0.0);
   CHECK(max_turn > 0.1);  // omega wandered by more than 0.1 rad
@@ -160,16 +161,18 @@ TEST_CASE("head-on contact of two one-particle bodies: restitution and duration"
       w.step(w.stable_dt());
       const double gap = (w.rigid_bodies()[1].com - w.rigid_bodies()[0].com).norm();
       if (t_start < 0 && gap < dx) t_start = w.time();
-      if (t_start >= 0 && t_end < 0 && w.rigid_bodies()[1].velocity().x() - w.rigid_bodies()[0].velocity().x() > 0 &&
-          gap >= dx)
+      if (t_start >= 0 && t_end < 0 &&
+          w.rigid_bodies()[1].velocity().x() - w.rigid_bodies()[0].velocity().x() > 0 && gap >= dx)
         t_end = w.time();
     }
     REQUIRE(t_end > 0);
     const double e = w.rigid_bodies()[1].velocity().x() - w.rigid_bodies()[0].velocity().x();
     const double e_ref = dem_reference(zeta, "e_num_force_end");
-    INFO("zeta " << zeta << ": e = " << e << " (reference " << e_ref << "), contact " << t_end - t_start << " s");
+    INFO("zeta " << zeta << ": e = " << e << " (reference " << e_ref << "), contact " << t_end - t_start
+                 << " s");
     CHECK(e == Approx(e_ref).epsilon(0.02));
-    // The contact ends when the force reaches zero, before the overlap does: duration between the two columns.
+    // The contact ends when the force reaches zero, before the overlap does: duration between the two
+    // columns.
     CHECK(t_end - t_start >= dem_reference(zeta, "tc_num_force_end_s") * 0.98);
     CHECK(t_end - t_start <= dem_reference(zeta, "tc_num_overlap_end_s") * 1.02);
   }
@@ -195,8 +198,8 @@ TEST_CASE("off-axis collision of two boxes: momentum, angular momentum, energy, 
   }
   const RigidTotals t1 = rigid_totals(w);
   const double pscale = std::abs(w.rigid_bodies()[0].mass) * 1.0;  // |P| of one body
-  INFO("dP = " << (t1.P - t0.P).norm() / pscale << ", dL = " << (t1.L - t0.L).norm() << ", E " << t0.E << " -> "
-               << t1.E);
+  INFO("dP = " << (t1.P - t0.P).norm() / pscale << ", dL = " << (t1.L - t0.L).norm() << ", E " << t0.E
+               << " -> " << t1.E);
   CHECK((t1.P - t0.P).norm() / pscale < 1e-9);
   // Angular momentum: every contact force acts at the contact point of its pair (contact_dem.hpp), so the
   // torques of a pair cancel and the symplectic update keeps sum(com x P + L) exact up to round-off.
@@ -229,7 +232,8 @@ TEST_CASE("rigid bodies in fluid: bitwise identical for 1 and 2 threads", "[rigi
     World w(s);
     for (int k = 0; k < 150; ++k) w.step(w.stable_dt());
     const RigidBody& b = w.rigid_bodies()[0];
-    std::vector<double> state = {b.com.x(), b.com.y(), b.com.z(), b.P.x(), b.P.y(), b.L.x(), b.L.z(), b.q.w()};
+    std::vector<double> state = {b.com.x(), b.com.y(), b.com.z(), b.P.x(),
+                                 b.P.y(),   b.L.x(),   b.L.z(),   b.q.w()};
     for (const Vec3& v : w.particles().v) state.push_back(v.x() + v.y() + v.z());
     if (t == 1)
       first = state;
@@ -268,7 +272,7 @@ TEST_CASE("fluid hits a rigid block without gravity: total momentum is conserved
   const auto [p1, unused] = total();
   const double vblock = w.rigid_bodies()[0].velocity().x();
   INFO("block speed " << vblock << ", momentum change " << (p1 - p0).norm() / scale);
-  CHECK(vblock > 0.05);                      // the fluid pushed the block
+  CHECK(vblock > 0.05);                     // the fluid pushed the block
   CHECK((p1 - p0).norm() / scale < 1e-12);  // and lost exactly what the block gained
 }
 
@@ -289,7 +293,8 @@ TEST_CASE("a dense block sinks, a light one floats, no fluid passes through", "[
     const double y0 = w.rigid_bodies()[0].com.y();
     while (w.time() < 0.45) w.step(w.stable_dt());
     const RigidBody& b = w.rigid_bodies()[0];
-    INFO("density " << density << ": block centre from " << y0 << " to " << b.com.y() << ", vy " << b.velocity().y());
+    INFO("density " << density << ": block centre from " << y0 << " to " << b.com.y() << ", vy "
+                    << b.velocity().y());
     if (density > 1000) {
       CHECK(b.com.y() < 0.08);  // went down through the water, near the bottom
     } else {

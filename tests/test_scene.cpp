@@ -55,9 +55,9 @@ TEST_CASE("a valid scene loads with its values and defaults", "[scene]") {
 }
 
 TEST_CASE("set overrides reach nested keys, list entries and optional keys", "[scene]") {
-  const LoadedScene l = load_scene_json(good(), {"resolution.spacing=0.004", "bodies.0.velocity=[0,0,-1]",
-                                                 "materials.water.viscosity=2e-6", "bodies.0.color=[1,0,0]",
-                                                 "time.end=0.5"});
+  const LoadedScene l =
+      load_scene_json(good(), {"resolution.spacing=0.004", "bodies.0.velocity=[0,0,-1]",
+                               "materials.water.viscosity=2e-6", "bodies.0.color=[1,0,0]", "time.end=0.5"});
   CHECK(l.scene.spacing == 0.004);
   CHECK(l.scene.bodies[0].velocity == Vec3(0, 0, -1));
   CHECK(l.scene.materials[l.scene.bodies[0].material].viscosity == 2e-6);
@@ -75,28 +75,89 @@ TEST_CASE("malformed scenes are refused with the JSON path", "[scene][bad-input]
   };
   const std::vector<Case> cases = {
       {"missing key", [](json& j) { j["resolution"].erase("spacing"); }, {}, "resolution.spacing: missing"},
-      {"wrong type", [](json& j) { j["resolution"]["spacing"] = "fine"; }, {}, "resolution.spacing: expected a number"},
-      {"negative spacing", [](json& j) { j["resolution"]["spacing"] = -0.01; }, {}, "resolution.spacing: must be positive"},
-      {"vector of 2", [](json& j) { j["bodies"][0]["shape"]["box"]["max"] = {1, 2}; }, {},
+      {"wrong type",
+       [](json& j) { j["resolution"]["spacing"] = "fine"; },
+       {},
+       "resolution.spacing: expected a number"},
+      {"negative spacing",
+       [](json& j) { j["resolution"]["spacing"] = -0.01; },
+       {},
+       "resolution.spacing: must be positive"},
+      {"vector of 2",
+       [](json& j) {
+         j["bodies"][0]["shape"]["box"]["max"] = {1, 2};
+       },
+       {},
        "bodies[0].shape.box.max: expected 3 numbers, got 2"},
-      {"box inverted", [](json& j) { j["bodies"][0]["shape"]["box"]["max"] = {-1, 1, 1}; }, {}, "bodies[0].shape.box.max"},
+      {"box inverted",
+       [](json& j) {
+         j["bodies"][0]["shape"]["box"]["max"] = {-1, 1, 1};
+       },
+       {},
+       "bodies[0].shape.box.max"},
       {"unknown key", [](json& j) { j["resolution"]["spasing"] = 1; }, {}, "resolution.spasing: unknown key"},
-      {"unknown material", [](json& j) { j["bodies"][0]["material"] = "blood"; }, {}, "unknown material 'blood'"},
-      {"poisson 0.5", [](json& j) { j["materials"]["rubber"]["poisson_ratio"] = 0.5; }, {}, "materials.rubber.poisson_ratio"},
-      {"poisson -1", [](json& j) { j["materials"]["rubber"]["poisson_ratio"] = -1.0; }, {}, "materials.rubber.poisson_ratio"},
-      {"young 0", [](json& j) { j["materials"]["rubber"]["youngs_modulus"] = 0; }, {}, "materials.rubber.youngs_modulus"},
+      {"unknown material",
+       [](json& j) { j["bodies"][0]["material"] = "blood"; },
+       {},
+       "unknown material 'blood'"},
+      {"poisson 0.5",
+       [](json& j) { j["materials"]["rubber"]["poisson_ratio"] = 0.5; },
+       {},
+       "materials.rubber.poisson_ratio"},
+      {"poisson -1",
+       [](json& j) { j["materials"]["rubber"]["poisson_ratio"] = -1.0; },
+       {},
+       "materials.rubber.poisson_ratio"},
+      {"young 0",
+       [](json& j) { j["materials"]["rubber"]["youngs_modulus"] = 0; },
+       {},
+       "materials.rubber.youngs_modulus"},
       {"density 0", [](json& j) { j["materials"]["water"]["density"] = 0; }, {}, "materials.water.density"},
-      {"material type", [](json& j) { j["materials"]["water"]["type"] = "gas"; }, {}, "materials.water.type: unknown value"},
-      {"two shapes", [](json& j) { j["bodies"][0]["shape"]["sphere"] = {{"center", {0, 0, 0}}, {"radius", 1}}; }, {}, "bodies[0].shape: expected exactly one shape"},
+      {"material type",
+       [](json& j) { j["materials"]["water"]["type"] = "gas"; },
+       {},
+       "materials.water.type: unknown value"},
+      {"two shapes",
+       [](json& j) {
+         j["bodies"][0]["shape"]["sphere"] = {{"center", {0, 0, 0}}, {"radius", 1}};
+       },
+       {},
+       "bodies[0].shape: expected exactly one shape"},
       {"duplicate body", [](json& j) { j["bodies"][1]["name"] = "a"; }, {}, "duplicate body name"},
-      {"probe body", [](json& j) { j["probes"][0]["bodies"] = {"zz"}; }, {}, "probes[0].bodies[0]: unknown body 'zz'"},
+      {"probe body",
+       [](json& j) { j["probes"][0]["bodies"] = {"zz"}; },
+       {},
+       "probes[0].bodies[0]: unknown body 'zz'"},
       {"probe axis", [](json& j) { j["probes"][0]["axis"] = "w"; }, {}, "probes[0].axis"},
-      {"open face", [](json& j) { j["bodies"][1]["shape"]["container"]["open"] = {"up"}; }, {}, "open[0]: unknown face"},
-      {"negative contact", [](json& j) { j["contact"] = {{"stiffness", -1}}; }, {}, "contact.stiffness"},
+      {"open face",
+       [](json& j) { j["bodies"][1]["shape"]["container"]["open"] = {"up"}; },
+       {},
+       "open[0]: unknown face"},
+      {"negative contact",
+       [](json& j) {
+         j["contact"] = {{"stiffness", -1}};
+       },
+       {},
+       "contact.stiffness"},
       {"cfl", [](json& j) { j["time"]["cfl"] = 2; }, {}, "time.cfl"},
-      {"odd width", [](json& j) { j["render"] = {{"width", 101}}; }, {}, "render.width: must be even"},
-      {"camera along up", [](json& j) { j["render"] = {{"cameras", {{{"name", "c"}, {"eye", {0, 1, 0}}, {"target", {0, 0, 0}}}}}}; }, {}, "render.cameras[0].up"},
-      {"figure camera", [](json& j) { j["render"] = {{"figures", {{{"name", "f"}, {"camera", "x"}, {"times", {0}}}}}}; }, {}, "unknown camera"},
+      {"odd width",
+       [](json& j) {
+         j["render"] = {{"width", 101}};
+       },
+       {},
+       "render.width: must be even"},
+      {"camera along up",
+       [](json& j) {
+         j["render"] = {{"cameras", {{{"name", "c"}, {"eye", {0, 1, 0}}, {"target", {0, 0, 0}}}}}};
+       },
+       {},
+       "render.cameras[0].up"},
+      {"figure camera",
+       [](json& j) {
+         j["render"] = {{"figures", {{{"name", "f"}, {"camera", "x"}, {"times", {0}}}}}};
+       },
+       {},
+       "unknown camera"},
       {"huge", [](json& j) { j["resolution"]["spacing"] = 1e-5; }, {}, "too many particles"},
       {"set unknown", [](json&) {}, {"resolution.spacin=0.004"}, "unknown path 'resolution.spacin'"},
       {"set index", [](json&) {}, {"bodies.7.velocity=[1,0,0]"}, "index 7 out of range"},
