@@ -130,7 +130,8 @@ std::vector<double> ProbeSet::measure(const World& world) const {
             n, Sum3{},
             [&](std::size_t i) {
               if (P.body[i] != pr.body) return Sum3{};
-              return Sum3{P.m[i] * P.x[i], P.m[i] * P.v[i], P.m[i]};
+              const double m = world.inertial_mass(i);
+              return Sum3{m * P.x[i], m * P.v[i], m};
             },
             [](const Sum3& a, const Sum3& b) { return a + b; });
         const Vec3 c = s.m > 0 ? Vec3(s.a / s.m) : Vec3::Constant(kNaN);
@@ -151,7 +152,8 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const Vec3 u = P.x[at] - P.x0[at];
         for (int d = 0; d < 3; ++d) out.push_back(u[d]);
         for (int d = 0; d < 3; ++d) out.push_back(P.v[at][d]);
-        out.push_back(0.0);  // von Mises stress: elastic solids only, none yet
+        const long slot = world.solids().slot(at);  // von Mises stress: elastic particles only
+        out.push_back(slot >= 0 ? world.solids().von_mises(static_cast<std::size_t>(slot)) : 0.0);
         break;
       }
       case ProbeType::Energy: {
@@ -164,7 +166,8 @@ std::vector<double> ProbeSet::measure(const World& world) const {
             n, E{},
             [&](std::size_t i) {
               if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid) return E{};
-              return E{0.5 * P.m[i] * P.v[i].squaredNorm(), -P.m[i] * g.dot(P.x[i])};
+              const double m = world.inertial_mass(i);
+              return E{0.5 * m * P.v[i].squaredNorm(), -m * g.dot(P.x[i])};
             },
             [](const E& a, const E& b) {
               return E{a.kin + b.kin, a.pot + b.pot};
@@ -175,7 +178,8 @@ std::vector<double> ProbeSet::measure(const World& world) const {
           kin += b.kinetic_energy();
           pot -= b.mass * g.dot(b.com);
         }
-        const double elastic = 0.0;
+        // Elastic solids: sum_s V_s psi(E_s), eqs. (15)-(16) (hourglass springs not counted).
+        const double elastic = world.solids().elastic_energy(P);
         out.insert(out.end(), {kin, pot, elastic, kin + pot + elastic});
         break;
       }
@@ -184,7 +188,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
             n, Sum3{},
             [&](std::size_t i) {
               if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid) return Sum3{};
-              const Vec3 p = P.m[i] * P.v[i];
+              const Vec3 p = world.inertial_mass(i) * P.v[i];
               return Sum3{p, P.x[i].cross(p), 0.0};
             },
             [](const Sum3& a, const Sum3& b) { return a + b; });

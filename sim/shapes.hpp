@@ -12,6 +12,8 @@ namespace aortasph {
 struct ShapeSample {
   std::vector<Vec3> points;  // particle centres, world coordinates, lexicographic lattice order
   SurfaceMesh mesh;          // surface for rendering, world coordinates
+  std::vector<uint8_t>
+      clamped;  // empty, or per point: 1 = held in place by the shape itself (elastic bodies)
 };
 
 // Lattice convention: a box [min, max] holds the centres min + (i + 1/2) dx, so the particles' cubes tile it

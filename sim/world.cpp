@@ -63,6 +63,7 @@ World::World(const Scene& scene)
       ctx_{kernel_, fluid_, gravity_, {}, {}} {
   const double dx = scene_.spacing;
   const double volume = dx * dx * dx;
+  std::vector<uint8_t> clamped;  // per particle: elastic and held in place
 
   // Read-only per-material constants.
   fluid_.resize(scene_.materials.size());
@@ -83,9 +84,6 @@ World::World(const Scene& scene)
     const Body& body = scene_.bodies[b];
     const Material& mat = scene_.materials.at(body.material);
     const std::string where = "bodies[" + std::to_string(b) + "] '" + body.name + "'";
-    if (mat.type == MaterialType::Elastic)
-      throw SetupError(where + ": material '" + mat.name +
-                       "' is of type elastic, which this version cannot " + "simulate yet");
     ShapeSample sample = sample_body(body, dx);
     if (sample.points.empty())
       throw SetupError(where + ": the shape holds no particle at spacing " + std::to_string(dx));
@@ -120,6 +118,22 @@ World::World(const Scene& scene)
       P_.rho[i] = rho0;
       if (mat.type != MaterialType::Wall)
         P_.v[i] = body.velocity + body.angular_velocity.cross(sample.points[k] - centroid);
+    }
+
+    // Elastic particles held at their reference position: the scene's fixed region and what the shape
+    // clamps itself (a leaflet's attachment to the wall).
+    if (mat.type == MaterialType::Elastic) {
+      clamped.resize(P_.size(), 0);
+      std::size_t held = 0;
+      for (std::size_t k = 0; k < sample.points.size(); ++k) {
+        const bool c = (body.fixed && body.fixed->contains(sample.points[k])) ||
+                       (!sample.clamped.empty() && sample.clamped[k]);
+        clamped[first + k] = c;
+        held += c;
+      }
+      if (body.fixed && held == 0)
+        throw SetupError(where + ".fixed: the region holds no particle of the body");
+      max_solid_c_ = std::max(max_solid_c_, SolidParams(mat).c);
     }
 
     // Fluid under gravity starts in hydrostatic balance: p = rho0 |g| depth below the body's top, and the
@@ -169,10 +183,16 @@ World::World(const Scene& scene)
   max_accel_ = gravity_.norm();
   for (const Vec3& v : P_.v) max_speed_ = std::max(max_speed_, v.norm());
 
+  // Elastic solids: reference configuration, neighbours and corrections, once.
+  clamped.resize(P_.size(), 0);
+  solids_ = Solids(P_, scene_.materials, kernel_, dx, clamped);
+  if (!solids_.empty() && contact_.k > 0.0)
+    min_contact_mass_ = std::min(min_contact_mass_, solids_.min_mass());
+
   // Spatial sort once, so neighbours sit close in memory from the first step.
   skin_ = 0.1 * kernel_.support;
   nb_.build(P_.x, kernel_.support, fixed_mask());
-  P_.permute(nb_.spatial_order());
+  permute(nb_.spatial_order());
   build_lists();
   fluid_pressure(P_, ctx_);
   boundary_from_fluid(P_, nb_, ctx_, wall_ref_);
@@ -188,13 +208,16 @@ double World::stable_dt() const {
   double dt = scene_.max_dt;
   // Acoustic CFL (Monaghan 1992): information crosses h in no less than h / (c0 + |v|max).
   if (max_c0_ > 0.0) dt = std::min(dt, scene_.cfl * h / (max_c0_ + max_speed_));
+  // Elastic solids: the same condition with the P-wave speed sqrt((lambda + 2 mu) / rho), the fastest signal
+  // of the solid.
+  if (max_solid_c_ > 0.0) dt = std::min(dt, scene_.cfl * h / (max_solid_c_ + max_speed_));
   // Viscous diffusion limit (Morris, Fox & Zhu 1997, eq. 18): dt <= 0.125 h^2 / nu.
   if (max_nu_ > 0.0) dt = std::min(dt, 0.125 * h * h / max_nu_);
   // Contact spring: two particles of mass m on a spring k touch for about pi sqrt(m / 2k) (m: see the
   // constructor for bodies of many particles). cfl * 0.1 sqrt(m / k)
   // resolves a contact in about 90 steps at cfl 0.25; the damped restitution converges to first order in dt
   // and is then within 2 % of the spring-dashpot formula up to zeta = 0.5 (tests/test_rigid.cpp).
-  if (!rigid_.empty() && contact_.k > 0.0)
+  if ((!rigid_.empty() || !solids_.empty()) && contact_.k > 0.0)
     dt = std::min(dt, scene_.cfl * 0.1 * std::sqrt(min_contact_mass_ / contact_.k));
   // Force limit (Monaghan 1992): dt <= 0.25 sqrt(h / |a|max).
   if (max_accel_ > 0.0) dt = std::min(dt, 0.25 * std::sqrt(h / max_accel_));
@@ -231,7 +254,7 @@ void World::build_lists() {
   nb_.build(P_.x, radius, fixed_mask());
   if (builds_ % sort_every_builds_ == sort_every_builds_ - 1) {
     const auto t0 = Clock::now();
-    P_.permute(nb_.spatial_order());
+    permute(nb_.spatial_order());
     nb_.build(P_.x, radius, fixed_mask());
     profile_.sort += seconds_since(t0);
   }
@@ -268,8 +291,17 @@ void World::step(double dt) {
   fluid_forces(P_, nb_, ctx);  // eqs. (9), (10), artificial viscosity, gravity
   profile_.forces += seconds_since(t0);
 
+  // Forces on body particles from the fluid and from contact (eqs. 23-25).
   t0 = Clock::now();
-  if (!rigid_.empty()) step_rigid(dt);
+  if (!rigid_.empty() || !solids_.empty()) body_forces();
+  profile_.rigid += seconds_since(t0);
+
+  t0 = Clock::now();
+  if (!solids_.empty()) step_solids();  // eqs. (14)-(18)
+  profile_.solid += seconds_since(t0);
+
+  t0 = Clock::now();
+  if (!rigid_.empty()) step_rigid(dt);  // eqs. (19)-(22)
   profile_.rigid += seconds_since(t0);
 
   t0 = Clock::now();
@@ -285,7 +317,7 @@ void World::step(double dt) {
 // Symplectic Euler, Algorithm 1 lines 15-16: v(t + dt) = v + dt a; x(t + dt) = x + dt v(t + dt).
 void World::integrate(double dt) {
   parallel_for(P_.size(), [&](std::size_t i) {
-    if (P_.kind[i] != Kind::Fluid) return;
+    if (P_.kind[i] != Kind::Fluid && P_.kind[i] != Kind::Elastic) return;
     P_.v[i] += dt * P_.a[i];
     P_.x[i] += dt * P_.v[i];
   });
@@ -310,12 +342,38 @@ void World::integrate(double dt) {
 // feels) and contact forces (eqs. 23-25), summed per body in array order (the same order for any thread
 // count), plus gravity; then each body advances and its particles follow. The particles' acceleration, which
 // the wall boundary needs (Adami et al. 2012, eq. 27), is their change of velocity over the step.
-void World::step_rigid(double dt) {
+void World::body_forces() {
   const std::size_t n = P_.size();
   force_.assign(n, Vec3::Zero());
   moment_.assign(n, Vec3::Zero());
   fluid_reaction(P_, nb_, ctx_, force_);
   contact_forces(P_, nb_, contact_, force_, moment_);
+}
+
+// Elastic particles: internal forces (eqs. 14-18 with their stabilisers) plus what body_forces() found (the
+// fluid's reaction and contact), over the particle's own mass, plus gravity. Clamped particles stay where
+// they are, with zero velocity and acceleration (the wall boundary reads their acceleration).
+void World::step_solids() {
+  solids_.update_stress(P_);
+  solids_.add_forces(P_, force_);
+  parallel_for(solids_.size(), [&](std::size_t s) {
+    const uint32_t i = solids_.at(s);
+    if (solids_.clamped(s)) {
+      P_.a[i] = Vec3::Zero();
+      P_.v[i] = Vec3::Zero();
+      return;
+    }
+    P_.a[i] = force_[i] / solids_.mass(s) + gravity_;
+  });
+}
+
+void World::permute(const std::vector<uint32_t>& order) {
+  P_.permute(order);
+  solids_.reindex(P_);
+}
+
+void World::step_rigid(double dt) {
+  const std::size_t n = P_.size();
   for (RigidBody& b : rigid_) {
     b.force = b.mass * gravity_;
     b.torque = Vec3::Zero();
@@ -386,7 +444,7 @@ void World::check_and_remove(double dt) {
         << fmt_vec(P_.x[first_out]);
     throw InstabilityError(msg.str());
   }
-  P_.permute(keep);
+  permute(keep);
   lists_valid_ = false;  // the lists refer to the old indices
 }
 
@@ -431,7 +489,9 @@ Snapshot World::snapshot(const std::string& field, int frame) const {
       s.field_unit = "m";
       for (std::size_t i = 0; i < n; ++i) s.field[i] = static_cast<float>((P_.x[i] - P_.x0[i]).norm());
     } else if (field == "stress") {
-      s.field_unit = "Pa";  // von Mises stress of elastic particles; zero elsewhere until solids exist
+      s.field_unit = "Pa";  // von Mises stress of elastic particles; zero elsewhere
+      for (std::size_t k = 0; k < solids_.size(); ++k)
+        s.field[solids_.at(k)] = static_cast<float>(solids_.von_mises(k));
     }
   }
   for (std::size_t b = 0; b < bodies_.size(); ++b) {

@@ -14,21 +14,22 @@
 #include "rigid_body.hpp"
 #include "scene.hpp"
 #include "snapshot.hpp"
+#include "solid_tlsph.hpp"
 
 namespace aortasph {
 
 // Wall time per phase of the step, summed over steps [s].
 struct Profile {
-  double neighbors = 0, density = 0, boundary = 0, forces = 0, rigid = 0, integrate = 0, sort = 0;
-  double total() const { return neighbors + density + boundary + forces + rigid + integrate + sort; }
+  double neighbors = 0, density = 0, boundary = 0, forces = 0, solid = 0, rigid = 0, integrate = 0, sort = 0;
+  double total() const { return neighbors + density + boundary + forces + solid + rigid + integrate + sort; }
   // (name, seconds) of each phase, in step order: the one list that diagnostics, run.json and bench print.
   std::vector<std::pair<std::string, double>> phases() const {
-    return {{"neighbors", neighbors}, {"density", density},     {"boundary", boundary}, {"forces", forces},
-            {"rigid", rigid},         {"integrate", integrate}, {"sort", sort}};
+    return {{"neighbors", neighbors}, {"density", density}, {"boundary", boundary},   {"forces", forces},
+            {"solid", solid},         {"rigid", rigid},     {"integrate", integrate}, {"sort", sort}};
   }
   Profile operator-(const Profile& o) const {
-    return {neighbors - o.neighbors, density - o.density,     boundary - o.boundary, forces - o.forces,
-            rigid - o.rigid,         integrate - o.integrate, sort - o.sort};
+    return {neighbors - o.neighbors, density - o.density, boundary - o.boundary,   forces - o.forces,
+            solid - o.solid,         rigid - o.rigid,     integrate - o.integrate, sort - o.sort};
   }
 };
 
@@ -46,6 +47,20 @@ class World {
   // Samples every body, sets masses, densities (hydrostatic for fluids under gravity) and velocities.
   // Throws SetupError when the scene cannot be built (empty body, overlapping bodies, unsupported model).
   explicit World(const Scene& scene);
+
+  // Sets the velocity of every moving particle of a body that is not clamped to v(x0), before the first step
+  // (initial conditions that a uniform body velocity cannot express: a mode shape, a pulse). Not for rigid
+  // bodies, whose particles follow the body.
+  template <class VelocityOf>
+  void set_initial_velocity(int body, VelocityOf&& v_of_x0) {
+    for (std::size_t i = 0; i < P_.size(); ++i) {
+      if (P_.body[i] != body || P_.kind[i] == Kind::Wall || P_.kind[i] == Kind::Rigid) continue;
+      const long s = solids_.slot(i);
+      if (s >= 0 && solids_.clamped(static_cast<std::size_t>(s))) continue;
+      P_.v[i] = v_of_x0(P_.x0[i]);
+      max_speed_ = std::max(max_speed_, P_.v[i].norm());
+    }
+  }
 
   // Largest stable time step now: acoustic CFL, viscous and force limits (Monaghan 1992; Morris et al. 1997)
   // and the scene's max_dt.
@@ -83,6 +98,13 @@ class World {
   const NeighborSearch& neighbors() const { return nb_; }
   const std::vector<BodyInfo>& bodies() const { return bodies_; }
   const std::vector<RigidBody>& rigid_bodies() const { return rigid_; }
+  const Solids& solids() const { return solids_; }
+  // Mass that moves particle i [kg]: an elastic particle's own mass; for others the mass of the fluid sums
+  // (rigid particles' mass lives in their RigidBody).
+  double inertial_mass(std::size_t i) const {
+    const long s = solids_.slot(i);
+    return s >= 0 ? solids_.mass(static_cast<std::size_t>(s)) : P_.m[i];
+  }
   const CubicSpline& kernel() const { return kernel_; }
   const std::vector<FluidParams>& fluid_params() const { return fluid_; }
   const Profile& profile() const { return profile_; }
@@ -107,7 +129,10 @@ class World {
   void build_lists();
   std::vector<uint8_t> fixed_mask() const;  // 1 for particles that never move (walls)
   void integrate(double dt);
+  void body_forces();
   void step_rigid(double dt);
+  void step_solids();
+  void permute(const std::vector<uint32_t>& order);
   void check_and_remove(double dt);
 
   Scene scene_;
@@ -120,6 +145,7 @@ class World {
   NeighborSearch nb_;
   std::vector<BodyInfo> bodies_;
   std::vector<RigidBody> rigid_;
+  Solids solids_;
   ContactParams contact_;
   double min_contact_mass_ = std::numeric_limits<double>::max();
   std::vector<Vec3> force_;   // per-particle force on body particles of the current step
@@ -133,6 +159,7 @@ class World {
   double speed_limit_ = 0.0;
   double max_c0_ = 0.0;
   double max_nu_ = 0.0;
+  double max_solid_c_ = 0.0;  // largest P-wave speed of the elastic materials
   std::size_t moving_at_start_ = 0;
   std::size_t left_domain_ = 0;
   // Verlet lists: built with radius support + skin, rebuilt when a particle has moved skin / 2.

@@ -1,0 +1,224 @@
+#include "solid_tlsph.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "neighbors.hpp"
+#include "parallel.hpp"
+#include "sim_errors.hpp"
+
+namespace aortasph {
+
+SolidParams::SolidParams(const Material& m)
+    : rho0(m.density),
+      E(m.youngs_modulus),
+      nu(m.poisson_ratio),
+      lambda(m.youngs_modulus * m.poisson_ratio / ((1.0 + m.poisson_ratio) * (1.0 - 2.0 * m.poisson_ratio))),
+      mu(m.youngs_modulus / (2.0 * (1.0 + m.poisson_ratio))),
+      c(std::sqrt((lambda + 2.0 * mu) / m.density)),
+      hourglass(m.hourglass),
+      alpha(m.solid_art_viscosity) {}
+
+StressState svk_stress(const Mat3& F, double lambda, double mu) {
+  StressState s;
+  // eq. (15)
+  const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
+  const double trE = E.trace();
+  // eq. (16), with the identity
+  s.S = lambda * trE * Mat3::Identity() + 2.0 * mu * E;
+  // eq. (17)
+  s.P = F * s.S;
+  s.energy_density = 0.5 * lambda * trE * trE + mu * E.cwiseProduct(E).sum();
+  // Cauchy stress sigma = J^-1 P F^T = J^-1 F S F^T, and its von Mises equivalent.
+  const double J = F.determinant();
+  const Mat3 sig = (std::abs(J) > 1e-12 ? 1.0 / J : 0.0) * (s.P * F.transpose());
+  const double d01 = sig(0, 0) - sig(1, 1), d12 = sig(1, 1) - sig(2, 2), d20 = sig(2, 2) - sig(0, 0);
+  const double shear = sig(0, 1) * sig(0, 1) + sig(1, 2) * sig(1, 2) + sig(2, 0) * sig(2, 0);
+  s.von_mises = std::sqrt(0.5 * (d01 * d01 + d12 * d12 + d20 * d20) + 3.0 * shear);
+  return s;
+}
+
+Solids::Solids(const Particles& P, const std::vector<Material>& materials, const CubicSpline& kernel,
+               double dx, const std::vector<uint8_t>& clamped)
+    : kernel_(&kernel) {
+  params_.resize(materials.size());
+  for (std::size_t m = 0; m < materials.size(); ++m)
+    if (materials[m].type == MaterialType::Elastic) params_[m] = SolidParams(materials[m]);
+
+  const double volume = dx * dx * dx;
+  min_mass_ = std::numeric_limits<double>::max();
+  uint32_t max_id = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) max_id = std::max(max_id, P.id[i]);
+  s_of_id_.assign(P.size() == 0 ? 0 : max_id + 1, kNone);
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.kind[i] != Kind::Elastic) continue;
+    const SolidParams& sp = params_[P.material[i]];
+    s_of_id_[P.id[i]] = static_cast<uint32_t>(id_.size());
+    id_.push_back(P.id[i]);
+    X_.push_back(P.x0[i]);
+    volume_.push_back(volume);
+    mass_.push_back(sp.rho0 * volume);
+    material_.push_back(P.material[i]);
+    clamped_.push_back(clamped.empty() ? 0 : clamped[i]);
+    max_c_ = std::max(max_c_, sp.c);
+    min_mass_ = std::min(min_mass_, sp.rho0 * volume);
+  }
+  const std::size_t n = X_.size();
+  F_.assign(n, Mat3::Identity());
+  P_.assign(n, Mat3::Zero());
+  vm_.assign(n, 0.0);
+  reindex(P);
+  if (n == 0) return;
+
+  // Reference neighbours: pairs of one body within the kernel support in the reference configuration.
+  NeighborSearch nb;
+  nb.build(X_, kernel.support);
+  std::vector<uint16_t> body(n);
+  for (std::size_t s = 0; s < n; ++s) body[s] = P.body[at_[s]];
+  offset_.assign(n + 1, 0);
+  for (std::size_t s = 0; s < n; ++s) {
+    uint32_t count = 0;
+    for (uint32_t k = nb.begin(s); k < nb.end(s); ++k) count += body[nb.index()[k]] == body[s];
+    offset_[s + 1] = offset_[s] + count;
+  }
+  nbr_.resize(offset_[n]);
+  for (std::size_t s = 0; s < n; ++s) {
+    uint32_t out = offset_[s];
+    for (uint32_t k = nb.begin(s); k < nb.end(s); ++k)
+      if (const uint32_t t = nb.index()[k]; body[t] == body[s]) nbr_[out++] = t;
+  }
+
+  // Correction matrices (Bonet & Lok 1999): L_s = (sum_t V_t grad_s W_st (x) (X_t - X_s))^-1. Where the
+  // neighbours do not span three dimensions (a single layer of particles) the pseudo-inverse corrects what
+  // they do span.
+  std::vector<Mat3> L(n);
+  parallel_for(n, [&](std::size_t s) {
+    Mat3 M = Mat3::Zero();
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const uint32_t t = nbr_[k];
+      const Vec3 Xst = X_[s] - X_[t];
+      M += volume_[t] * kernel.gradW(Xst, Xst.norm()) * (X_[t] - X_[s]).transpose();
+    }
+    const double scale = M.trace() / 3.0;
+    if (std::abs(M.determinant()) > 1e-3 * std::abs(scale * scale * scale))
+      L[s] = M.inverse();
+    else
+      L[s] = M.completeOrthogonalDecomposition().pseudoInverse();
+  });
+  g_ij_.resize(nbr_.size());
+  g_ji_.resize(nbr_.size());
+  w_ij_.resize(nbr_.size());
+  parallel_for(n, [&](std::size_t s) {
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const uint32_t t = nbr_[k];
+      const Vec3 Xst = X_[s] - X_[t];
+      const double r = Xst.norm();
+      const Vec3 grad = kernel.gradW(Xst, r);  // grad_s W(X_s - X_t) = -grad_t W(X_t - X_s)
+      g_ij_[k] = L[s] * grad;
+      g_ji_[k] = -(L[t] * grad);
+      w_ij_[k] = kernel.W(r);
+    }
+  });
+}
+
+void Solids::reindex(const Particles& P) {
+  at_.assign(X_.size(), kNone);
+  slot_.assign(P.size(), kNone);
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.kind[i] != Kind::Elastic || P.id[i] >= s_of_id_.size()) continue;
+    const uint32_t s = s_of_id_[P.id[i]];
+    if (s == kNone) continue;
+    at_[s] = static_cast<uint32_t>(i);
+    slot_[i] = s;
+  }
+  for (std::size_t s = 0; s < X_.size(); ++s)
+    if (at_[s] == kNone) {
+      std::ostringstream msg;
+      msg << "elastic particle " << id_[s] << " (reference position " << X_[s].transpose()
+          << ") left the domain: its body cannot hold together without it";
+      throw InstabilityError(msg.str());
+    }
+}
+
+Mat3 Solids::deformation_gradient(const Particles& P, std::size_t s) const {
+  if (offset_[s] == offset_[s + 1]) return Mat3::Identity();  // an isolated particle carries no stress
+  const Vec3 xs = P.x[at_[s]];
+  // eq. (14), corrected: F_s = sum_t V_t (x_t - x_s) (x) g_st
+  Mat3 F = Mat3::Zero();
+  for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+    const uint32_t t = nbr_[k];
+    F += volume_[t] * (P.x[at_[t]] - xs) * g_ij_[k].transpose();
+  }
+  return F;
+}
+
+void Solids::update_stress(const Particles& P) {
+  parallel_for(X_.size(), [&](std::size_t s) {
+    const Mat3 F = deformation_gradient(P, s);
+    const SolidParams& sp = params_[material_[s]];
+    const StressState st = svk_stress(F, sp.lambda, sp.mu);
+    F_[s] = F;
+    P_[s] = st.P;
+    vm_[s] = st.von_mises;
+  });
+}
+
+void Solids::add_forces(const Particles& P, std::vector<Vec3>& f) const {
+  const CubicSpline& K = *kernel_;
+  const double h = K.h;
+  const double eta2 = 0.01 * h * h;
+  parallel_for_dynamic(X_.size(), [&](std::size_t s) {
+    const uint32_t i = at_[s];
+    if (clamped_[s]) return;  // held at its reference position: no force needed
+    const SolidParams& sp = params_[material_[s]];
+    const Vec3 xi = P.x[i], vi = P.v[i];
+    Vec3 elastic = Vec3::Zero(), other = Vec3::Zero();
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const uint32_t t = nbr_[k];
+      const uint32_t j = at_[t];
+      // eq. (18) with corrected gradients: f_s = V_s sum_t V_t (P_s g_st - P_t g_ts)
+      elastic += volume_[t] * (P_[s] * g_ij_[k] - P_[t] * g_ji_[k]);
+
+      const Vec3 xij = P.x[j] - xi;  // from s to t, current
+      const double r = xij.norm();
+      if (r <= 0.0) continue;
+      const Vec3 e = xij / r;
+      // Hourglass control (Ganzenmueller 2015, eqs. 19-23): eps_s = F_s X_st - x_st is where F_s puts t
+      // relative to where t is; its component along the pair, averaged with t's view, is pushed back by a
+      // spring of stiffness alpha E V_s V_t W / |X|^2. Zero for every affine deformation.
+      if (sp.hourglass > 0.0) {
+        const Vec3 X = X_[t] - X_[s];
+        const double X2 = X.squaredNorm();
+        const double delta_s = (F_[s] * X - xij).dot(e);
+        const double delta_t = (F_[t] * X - xij).dot(e);  // = (F_t X_ts - x_ts) . e_ts
+        const double delta = 0.5 * (delta_s + delta_t);
+        other -= (0.5 * sp.hourglass * sp.E * volume_[s] * volume_[t] * w_ij_[k] / X2 * delta) * e;
+      }
+      // Artificial viscosity (Monaghan 1992) for approaching pairs, on the current distance.
+      if (sp.alpha > 0.0) {
+        const Vec3 x_ij = -xij;  // x_s - x_t
+        const double vx = (vi - P.v[j]).dot(x_ij);
+        if (vx < 0.0) {
+          const double mu = h * vx / (r * r + eta2);
+          const double Pi = -sp.alpha * sp.c * mu / sp.rho0;
+          other -= (mass_[s] * mass_[t] * Pi * K.dWdr(r) / r) * x_ij;
+        }
+      }
+    }
+    f[i] += volume_[s] * elastic + other;
+  });
+}
+
+double Solids::elastic_energy(const Particles& P) const {
+  return parallel_reduce(
+      X_.size(), 0.0,
+      [&](std::size_t s) {
+        const SolidParams& sp = params_[material_[s]];
+        return volume_[s] * svk_stress(deformation_gradient(P, s), sp.lambda, sp.mu).energy_density;
+      },
+      [](double a, double b) { return a + b; });
+}
+
+}  // namespace aortasph

@@ -1,0 +1,297 @@
+// Elastic solids by Total-Lagrangian SPH (paper eqs. 14-18) with gradient correction, hourglass control and
+// artificial viscosity: patch tests, wave speed, cantilever vibration, energy, large deformation, bad input.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+
+#include "builders.hpp"
+#include "parallel.hpp"
+#include "probes.hpp"
+#include "sim_errors.hpp"
+#include "solid_tlsph.hpp"
+#include "world.hpp"
+
+using namespace aortasph;
+using namespace aortasph::test;
+
+namespace {
+
+Material rubber(double E, double nu, double rho = 1000.0) {
+  Material m;
+  m.name = "rubber";
+  m.type = MaterialType::Elastic;
+  m.density = rho;
+  m.youngs_modulus = E;
+  m.poisson_ratio = nu;
+  return m;
+}
+
+// A block of nx x ny x nz elastic particles at spacing dx, set up by hand (reference = current).
+Particles block(int nx, int ny, int nz, double dx) {
+  Particles P;
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j)
+      for (int k = 0; k < nz; ++k) {
+        const std::size_t n = P.size();
+        P.resize(n + 1);
+        P.x[n] = P.x0[n] = dx * Vec3(i + 0.5, j + 0.5, k + 0.5);
+        P.kind[n] = Kind::Elastic;
+        P.id[n] = static_cast<uint32_t>(n);
+        P.m[n] = 1000.0 * dx * dx * dx;
+      }
+  return P;
+}
+
+double max_abs(const Mat3& M) {
+  return M.cwiseAbs().maxCoeff();
+}
+
+// A scene with one elastic box body along x, clamped where x < 0, no gravity unless given.
+Scene beam_scene(double length, double H, double W, double clamp, double dx, const Material& mat,
+                 Vec3 gravity = Vec3::Zero()) {
+  Scene s;
+  s.name = "beam";
+  s.spacing = dx;
+  s.gravity = gravity;
+  s.domain = {Vec3(-1, -1, -1), Vec3(2, 1, 1)};
+  s.max_dt = 1e-3;
+  s.materials = {mat};
+  Body b = box_body("beam", 0, Vec3(-clamp, 0, 0), Vec3(length, H, W));
+  if (clamp > 0.0) b.fixed = Box{Vec3(-1, -1, -1), Vec3(0, 1, 1)};
+  s.bodies = {b};
+  return s;
+}
+
+// Mean of a vector field component over the particles of a world with x0 in a slab |x0.x - x| < dx/2.
+double mean_in_slab(const World& w, double x, double dx, auto&& value) {
+  const Particles& P = w.particles();
+  double sum = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (std::abs(P.x0[i].x() - x) < 0.5 * dx) {
+      sum += value(i);
+      ++n;
+    }
+  return n ? sum / n : 0.0;
+}
+
+// First-mode shape of a clamped-free beam (Euler-Bernoulli), normalised to 1 at the tip: x from the clamp.
+double mode1(double x, double L) {
+  const double kL = 1.875104068711961, k = kL / L;
+  const double M = std::sin(kL) + std::sinh(kL), N = std::cos(kL) + std::cosh(kL);
+  auto f = [&](double s) {
+    return M * (std::cos(k * s) - std::cosh(k * s)) - N * (std::sin(k * s) - std::sinh(k * s));
+  };
+  return f(x) / f(L);
+}
+
+struct Oscillation {
+  double period = 0.0;  // mean time between upward zero crossings of the tip displacement [s]
+  double decay = 0.0;   // mean relative amplitude loss per period
+  int crossings = 0;
+  double max_energy_drift = 0.0;  // max |E(t) / E(0) - 1|
+};
+
+// Runs a clamped beam given its first-mode velocity profile (tip speed v_tip, along y) for `periods` beam
+// periods and measures its tip oscillation and energy.
+Oscillation vibrate(World& w, double L, double v_tip, double t_end, double sample) {
+  w.set_initial_velocity(0,
+                         [&](const Vec3& x0) { return Vec3(0, v_tip * mode1(std::max(x0.x(), 0.0), L), 0); });
+  const double dx = w.scene().spacing;
+  const double x_tip = L - 0.5 * dx;
+  Scene probe_scene = w.scene();
+  probe_scene.probes = {Probe{}};
+  probe_scene.probes[0].name = "e";
+  probe_scene.probes[0].type = ProbeType::Energy;
+  ProbeSet energy(probe_scene, w);
+  const double e0 = energy.measure(w)[3];
+  Oscillation o;
+  double prev = 0.0, t_prev = 0.0, first_cross = -1, last_cross = -1;
+  std::vector<double> peaks;
+  double peak = 0.0;
+  while (w.time() < t_end - 1e-12) {
+    w.advance_to(std::min(t_end, w.time() + sample), [] { return true; });
+    const double uy = mean_in_slab(
+        w, x_tip, dx, [&](std::size_t i) { return w.particles().x[i].y() - w.particles().x0[i].y(); });
+    const double e = energy.measure(w)[3];
+    o.max_energy_drift = std::max(o.max_energy_drift, std::abs(e / e0 - 1.0));
+    peak = std::max(peak, uy);
+    // Upward zero crossing, interpolated linearly.
+    if (prev < 0.0 && uy >= 0.0) {
+      const double tc = t_prev + (w.time() - t_prev) * (-prev) / (uy - prev);
+      if (first_cross < 0) first_cross = tc;
+      last_cross = tc;
+      ++o.crossings;
+      peaks.push_back(peak);
+      peak = 0.0;
+    }
+    prev = uy;
+    t_prev = w.time();
+  }
+  if (o.crossings >= 2) o.period = (last_cross - first_cross) / (o.crossings - 1);
+  // peaks[k] is the maximum between crossings k-1 and k; peaks[1..] are full periods.
+  if (peaks.size() >= 3)
+    o.decay = 1.0 - std::pow(peaks.back() / peaks[1], 1.0 / static_cast<double>(peaks.size() - 2));
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("TL-SPH patch tests: rigid motions give zero stress, a uniform stretch the analytic S and P",
+          "[solid]") {
+  const double dx = 0.01;
+  Particles P = block(9, 9, 9, dx);
+  const Material mat = rubber(1e6, 0.3);
+  const CubicSpline K(1.3 * dx);
+  Solids solid(P, {mat}, K, dx, {});
+  REQUIRE(solid.size() == P.size());
+  const SolidParams sp(mat);
+
+  SECTION("translation") {
+    for (std::size_t i = 0; i < P.size(); ++i) P.x[i] = P.x0[i] + Vec3(0.3, -0.2, 0.05);
+    solid.update_stress(P);
+    for (std::size_t s = 0; s < solid.size(); ++s) {
+      CHECK(max_abs(solid.F(s) - Mat3::Identity()) < 1e-12);
+      CHECK(max_abs(solid.PK1(s)) < 1e-9 * sp.E);
+    }
+  }
+  SECTION("rotation") {
+    const Mat3 R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+    for (std::size_t i = 0; i < P.size(); ++i) P.x[i] = R * P.x0[i] + Vec3(0.1, 0.0, 0.0);
+    solid.update_stress(P);
+    double worst = 0;
+    for (std::size_t s = 0; s < solid.size(); ++s) {
+      CHECK(max_abs(solid.F(s) - R) < 1e-12);
+      worst = std::max(worst, max_abs(solid.PK1(s)));
+      CHECK(solid.von_mises(s) < 1e-9 * sp.E);
+    }
+    CHECK(worst < 1e-9 * sp.E);
+    std::vector<Vec3> f(P.size(), Vec3::Zero());
+    solid.add_forces(P, f);
+    for (const Vec3& fi : f) CHECK(fi.norm() < 1e-9 * sp.E * dx * dx);
+  }
+  SECTION("uniform stretch, every particle including the surface") {
+    const Mat3 Fa = Vec3(1.1, 0.95, 1.02).asDiagonal();
+    for (std::size_t i = 0; i < P.size(); ++i) P.x[i] = Fa * P.x0[i];
+    solid.update_stress(P);
+    const Mat3 E = 0.5 * (Fa.transpose() * Fa - Mat3::Identity());
+    const Mat3 S = sp.lambda * E.trace() * Mat3::Identity() + 2.0 * sp.mu * E;
+    const Mat3 Pa = Fa * S;
+    for (std::size_t s = 0; s < solid.size(); ++s) {
+      CHECK(max_abs(solid.F(s) - Fa) < 1e-12);
+      CHECK(max_abs(solid.PK1(s) - Pa) < 1e-9 * sp.E);
+    }
+    // The analytic values themselves: lambda = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)).
+    CHECK(sp.lambda == Approx(1e6 * 0.3 / (1.3 * 0.4)));
+    CHECK(sp.mu == Approx(1e6 / 2.6));
+    // A uniform stress is in equilibrium: the centre particle, whose neighbours all have full kernel
+    // support, feels no net force (to round-off), while surface particles carry the traction.
+    std::vector<Vec3> f(P.size(), Vec3::Zero());
+    solid.add_forces(P, f);
+    const std::size_t centre = 4 * 81 + 4 * 9 + 4;
+    CHECK(f[centre].norm() < 1e-9 * sp.E * dx * dx);
+    CHECK(f[0].norm() > 1e-3 * sp.E * dx * dx);
+  }
+}
+
+TEST_CASE("TL-SPH: internal forces conserve momentum and angular momentum", "[solid][conservation]") {
+  const double dx = 0.01;
+  Particles P = block(6, 5, 4, dx);
+  const Material mat = rubber(1e6, 0.45);
+  const CubicSpline K(1.3 * dx);
+  Solids solid(P, {mat}, K, dx, {});
+  // A random-looking but deterministic deformation and velocity field.
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    const double a = static_cast<double>(i);
+    P.x[i] = P.x0[i] + 0.1 * dx * Vec3(std::sin(1.3 * a), std::cos(2.1 * a), std::sin(0.7 * a + 1));
+    P.v[i] = Vec3(std::cos(0.3 * a), std::sin(1.7 * a), std::cos(2.9 * a));
+  }
+  solid.update_stress(P);
+  std::vector<Vec3> f(P.size(), Vec3::Zero());
+  solid.add_forces(P, f);
+  Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+  double scale = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    F += f[i];
+    M += P.x[i].cross(f[i]);
+    scale += f[i].norm();
+  }
+  REQUIRE(scale > 0.0);
+  CHECK(F.norm() < 1e-12 * scale);
+  // eq. (18) and the stabilisers act along pairs or derive from a rotation-invariant energy.
+  CHECK(M.norm() < 1e-10 * scale * 0.1);
+}
+
+TEST_CASE("TL-SPH: a velocity pulse in a thin bar travels at sqrt(E/rho) and inverts at a fixed end",
+          "[solid][validation]") {
+  // tests/data/elastic_wave_speeds_examples.csv, row oscillating_plate_GMS2001: E = 2 MPa, rho = 1000,
+  // nu = 0.3975, c_bar = 44.7214 m/s (the bar speed: the P-wave speed 64.85 m/s needs lateral constraint).
+  const double c_bar = 44.7214, dx = 0.01, L = 1.2, H = 0.04;
+  const Material mat = rubber(2e6, 0.3975);
+  Scene s = beam_scene(L, H, H, 0.0, dx, mat);
+  s.bodies[0].fixed = Box{Vec3(L - dx, -1, -1), Vec3(2, 1, 1)};  // the last layer at x = L is held
+  World w(s);
+  // A half-sine velocity pulse of length 0.2 m centred at x = 0.3: it splits into two halves of amplitude
+  // v0 / 2 running left and right.
+  const double v0 = 0.02, xc = 0.3, half = 0.1;
+  w.set_initial_velocity(0, [&](const Vec3& x0) {
+    const double d = x0.x() - xc;
+    return Vec3(std::abs(d) < half ? v0 * std::cos(0.5 * std::numbers::pi * d / half) : 0.0, 0, 0);
+  });
+  const std::vector<double> gauges = {0.555, 0.855, 1.055};
+  std::vector<double> t_peak(gauges.size(), 0.0), v_peak(gauges.size(), 0.0), v_min(gauges.size(), 0.0);
+  std::vector<std::array<double, 3>> last(gauges.size(), {0, 0, 0});  // (t, v) history for the peak fit
+  const double sample = 2e-5, t_end = 0.95 * (2 * L - xc - gauges[2]) / c_bar + 0.3 / c_bar;
+  double t_prev2 = 0, t_prev = 0;
+  std::vector<double> v_prev2(gauges.size(), 0), v_prev(gauges.size(), 0);
+  while (w.time() < t_end) {
+    w.advance_to(w.time() + sample, [] { return true; });
+    for (std::size_t g = 0; g < gauges.size(); ++g) {
+      const double v = mean_in_slab(w, gauges[g], dx, [&](std::size_t i) { return w.particles().v[i].x(); });
+      // Peak: a local maximum of the sampled signal, refined by a parabola through three samples.
+      if (v_prev[g] > v_peak[g] && v_prev[g] >= v && v_prev[g] >= v_prev2[g]) {
+        const double a = v_prev2[g], b = v_prev[g], c = v;
+        const double denom = a - 2 * b + c;
+        const double shift = denom != 0.0 ? 0.5 * (a - c) / denom : 0.0;
+        t_peak[g] = t_prev + shift * sample;
+        v_peak[g] = b;
+      }
+      v_min[g] = std::min(v_min[g], v);
+      v_prev2[g] = v_prev[g];
+      v_prev[g] = v;
+    }
+    t_prev2 = t_prev;
+    t_prev = w.time();
+  }
+  (void)t_prev2;
+  const double c = (gauges[1] - gauges[0]) / (t_peak[1] - t_peak[0]);
+  INFO("measured pulse speed " << c << " m/s, bar speed " << c_bar << " m/s; peaks " << v_peak[0] << ", "
+                               << v_peak[1] << " at " << t_peak[0] << ", " << t_peak[1] << " s");
+  CHECK(std::abs(c / c_bar - 1.0) < 0.05);
+  // Each half carries v0 / 2; dispersion and viscosity may lower the peak a little, not raise it.
+  CHECK(v_peak[0] == Approx(0.5 * v0).epsilon(0.15));
+  // Reflection at the fixed end: the velocity at x = 1.05 turns negative, about as large as it came in.
+  INFO("gauge at 1.05 m: incoming peak " << v_peak[2] << ", reflected minimum " << v_min[2]);
+  CHECK(v_min[2] < -0.6 * v_peak[2]);
+}
+
+// Measurement harness for the cantilever period (issue 5, item 3), not yet a pass/fail test: at 4 layers the
+// period is 1.20-1.31 x Euler-Bernoulli, at 6 layers 1.09-1.14 x (docs in the session note).
+TEST_CASE("TL-SPH scratch: beam period vs resolution", "[.scratch]") {
+  const double L = 0.2, H = 0.02;
+  const int layers = std::getenv("LAYERS") ? std::atoi(std::getenv("LAYERS")) : 4;
+  const double dx = H / layers;
+  Material mat = rubber(2e6, 0.3975);
+  if (std::getenv("HG")) mat.hourglass = std::atof(std::getenv("HG"));
+  if (std::getenv("AV")) mat.solid_art_viscosity = std::atof(std::getenv("AV"));
+  Scene sc = beam_scene(L, H, H, 0.03, dx, mat);
+  if (std::getenv("RATIO")) sc.smoothing_ratio = std::atof(std::getenv("RATIO"));
+  World w(sc);
+  const double omega = std::pow(1.875104 / L, 2) * std::sqrt(2e6 * H * H / 12.0 / 1000.0);
+  const double T = 2 * std::numbers::pi / omega;
+  const double periods = std::getenv("PERIODS") ? std::atof(std::getenv("PERIODS")) : 2.2;
+  const Oscillation o = vibrate(w, L, 0.05, periods * T, T / 200);
+  WARN("layers " << layers << " period " << o.period / T << " x EB; decay " << o.decay << " crossings "
+                 << o.crossings << " drift " << o.max_energy_drift << " steps " << w.steps());
+}
