@@ -193,7 +193,7 @@ class Loader {
     if (s.smoothing_ratio < 1.0 || s.smoothing_ratio > 3.0)
       fail(res.path("smoothing_ratio"), "must lie in 1..3");
 
-    Obj time(top.raw("time"), "time", {"end", "output_interval", "cfl", "max_dt", "max_speed", "fixed_dt"},
+    Obj time(top.raw("time"), "time", {"end", "output_interval", "cfl", "max_dt", "max_speed", "max_density_error", "fixed_dt"},
              allowed);
     s.t_end = time.positive("end");
     s.output_interval = time.positive("output_interval");
@@ -201,6 +201,7 @@ class Loader {
     if (s.cfl > 1) fail(time.path("cfl"), "must lie in (0, 1]");
     s.max_dt = time.positive("max_dt", 1e-3);
     s.max_speed = time.non_negative("max_speed", 0.0);
+    s.max_density_error = time.non_negative("max_density_error", 0.5);
     s.fixed_dt = time.non_negative("fixed_dt", 0.0);
     if (s.t_end / s.output_interval > 1e6) fail(time.path("output_interval"), "more than a million outputs");
 
