@@ -621,7 +621,8 @@ LoadedScene load_scene(const std::filesystem::path& file, const std::vector<std:
   json j;
   try {
     j = json::parse(f);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
+    // parse_error, and out_of_range for a number beyond the double range (1e999).
     throw InputError(file.string() + ": not valid JSON: " + e.what());
   }
   return load_scene_json(j, overrides, file.parent_path());
