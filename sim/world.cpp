@@ -367,7 +367,8 @@ void World::check_and_remove(double dt) {
     const std::size_t over = parallel_reduce(
         n, n,
         [&](std::size_t i) {
-          if (P_.kind[i] != Kind::Fluid) return n;
+          // Density summation (eq. 11) makes free-surface particles under-dense by design: not checked.
+          if (P_.kind[i] != Kind::Fluid || fluid_[P_.material[i]].summation) return n;
           return std::abs(P_.rho[i] / fluid_[P_.material[i]].rho0 - 1.0) > limit ? i : n;
         },
         [](std::size_t a, std::size_t b) { return std::min(a, b); });
