@@ -259,6 +259,12 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   check_resources(scene, dir, outputs + 1 - first_frame + (scene.t_end > outputs * scene.output_interval),
                   render, o.vtk);
 
+  if (!resume) {
+    // A checkpoint left by an earlier run in this folder would no longer match the files this run writes.
+    std::error_code ec;
+    std::filesystem::remove(dir / kCheckpointFile, ec);
+  }
+
   const auto wall_start = Clock::now();
   World world(scene);
   ProbeSet probes(scene, world);  // resolved on the state at t = 0, as in the run that wrote the checkpoint
