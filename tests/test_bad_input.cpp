@@ -187,3 +187,21 @@ TEST_CASE("bad input: a write error during a run (disk full) exits 2 naming the 
   CHECK(code == 2);
   CHECK(err.find("probes.csv: write failed") != std::string::npos);
 }
+
+TEST_CASE("bad input: a frame that cannot be written stops the run with exit 2, no partial PNG",
+          "[bad-input][cli]") {
+  const fs::path dir = scratch("frame");
+  std::ofstream(dir / "scene.json") << kGood;
+  // A directory where the PNG's temporary file must go: the write of frame 1 fails (as on a full disk).
+  fs::create_directories(dir / "out" / "frames" / "front" / "frame_00001.png.tmp");
+  std::string err;
+  const int code =
+      run_cli("run " + (dir / "scene.json").string() + " --quiet --out " + (dir / "out").string(), err);
+  INFO(err);
+  CHECK(code == 2);
+  CHECK(err.find("rendering failed") != std::string::npos);
+  CHECK(err.find("frame_00001.png") != std::string::npos);
+  CHECK(fs::exists(dir / "out" / "frames" / "front" / "frame_00000.png"));
+  CHECK_FALSE(fs::exists(dir / "out" / "frames" / "front" / "frame_00001.png"));
+  CHECK(slurp(dir / "out" / "run.json").find("\"status\": \"failed\"") != std::string::npos);
+}
