@@ -80,9 +80,10 @@ TEST_CASE("watchdog: a time step forced too large exits 3 naming time, step, bod
   std::ofstream(dir / "scene.json") << kScene;
   std::string err;
   // About 10 times the acoustic CFL step: grows for a few outputs, then blows up.
-  const int code = run_cli("run " + (dir / "scene.json").string() + " --quiet --out " +
-                               (dir / "out").string() + " --set time.fixed_dt=0.003 --set time.output_interval=0.008",
-                           err);
+  const int code =
+      run_cli("run " + (dir / "scene.json").string() + " --quiet --out " + (dir / "out").string() +
+                  " --set time.fixed_dt=0.003 --set time.output_interval=0.008",
+              err);
   INFO(err);
   CHECK(code == 3);
   CHECK(err.find("unstable at t = ") != std::string::npos);
