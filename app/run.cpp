@@ -195,6 +195,8 @@ struct RunRecord {
   std::vector<std::string> sets;
   bool no_render = false, vtk = false;
   double checkpoint_every = 0.0, next_checkpoint = 0.0;
+  // --end-time: the end the run uses and the scene file's own (figures are validated against the latter).
+  double end_override = 0.0, file_end = 0.0;
   int32_t frames = 0;
   std::optional<std::pair<double, double>> range;
 
@@ -210,6 +212,8 @@ struct RunRecord {
     w.value(vtk);
     w.value(checkpoint_every);
     w.value(next_checkpoint);
+    w.value(end_override);
+    w.value(file_end);
     w.value(frames);
     w.value(range.has_value());
     w.value(range ? range->first : 0.0);
@@ -233,6 +237,8 @@ struct RunRecord {
     rec.vtk = r.value<bool>();
     rec.checkpoint_every = r.value<double>();
     rec.next_checkpoint = r.value<double>();
+    rec.end_override = r.value<double>();
+    rec.file_end = r.value<double>();
     rec.frames = r.value<int32_t>();
     const bool has_range = r.value<bool>();
     const double lo = r.value<double>(), hi = r.value<double>();
@@ -247,7 +253,7 @@ struct RunRecord {
 
 // The run itself, fresh or resumed (resume: the checkpoint and its record; the World is built from the scene
 // and then given the checkpoint's state, so it continues exactly where the interrupted run stopped).
-int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path& dir,
+int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path& dir, double file_end,
             const StateReader* resume, const RunRecord* record) {
   Scene& scene = loaded.scene;
   prepare_out_dir(dir);
@@ -317,6 +323,8 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   rec.vtk = o.vtk;
   rec.checkpoint_every = o.checkpoint_every.value_or(0.0);
   rec.next_checkpoint = record ? record->next_checkpoint : rec.checkpoint_every;
+  rec.end_override = o.end_time.value_or(0.0);
+  rec.file_end = file_end;
 
   // A checkpoint counts only what is on disk: the frames pushed so far are written first (the CSV rows are
   // flushed row by row). Written atomically, so a kill at any moment leaves the previous or this one.
@@ -433,12 +441,13 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
 
 int cmd_run(const RunOptions& o) {
   LoadedScene loaded = load_scene(o.scene, o.sets);
+  const double file_end = loaded.scene.t_end;
   if (o.end_time) {
     loaded.scene.t_end = *o.end_time;
     loaded.resolved["time"]["end"] = *o.end_time;
   }
   const std::filesystem::path dir = o.out ? *o.out : std::filesystem::path("out") / loaded.scene.name;
-  return execute(std::move(loaded), o, dir, nullptr, nullptr);
+  return execute(std::move(loaded), o, dir, file_end, nullptr, nullptr);
 }
 
 ResumeOptions parse_resume_options(const std::vector<std::string>& args) {
@@ -490,7 +499,17 @@ int cmd_resume(const ResumeOptions& ro) {
       throw InputError((ro.dir / "run.json").string() + " describes another scene than " + file.string() +
                        " (scene hash mismatch); refusing to mix two runs in one folder");
   }
-  LoadedScene loaded = load_scene_json(resolved, {});
+  // Loaded as the file was (figure times are checked against the file's time.end), then --end-time again.
+  nlohmann::json as_file = resolved;
+  if (record.end_override > 0.0) as_file["time"]["end"] = record.file_end;
+  LoadedScene loaded = load_scene_json(as_file, {});
+  if (record.end_override > 0.0) {
+    loaded.scene.t_end = record.end_override;
+    loaded.resolved["time"]["end"] = record.end_override;
+  }
+  if (scene_hash(loaded.resolved) != record.hash)
+    throw InputError(file.string() + ": the recorded scene no longer resolves to the same values with this " +
+                     "program; cannot resume");
   RunOptions o;
   o.scene = record.scene_file;
   o.out = ro.dir;
@@ -500,8 +519,9 @@ int cmd_resume(const ResumeOptions& ro) {
   o.vtk = record.vtk;
   o.quiet = ro.quiet;
   if (record.checkpoint_every > 0.0) o.checkpoint_every = record.checkpoint_every;
+  if (record.end_override > 0.0) o.end_time = record.end_override;
   try {
-    return execute(std::move(loaded), o, ro.dir, &state, &record);
+    return execute(std::move(loaded), o, ro.dir, record.file_end, &state, &record);
   } catch (const SetupError& e) {
     throw InputError(std::string("resume: ") + e.what());
   }

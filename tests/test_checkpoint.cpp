@@ -358,3 +358,24 @@ TEST_CASE("checkpoint: resume refuses another version, another scene, no checkpo
   CHECK(run_cli("resume " + scratch("empty").string(), &err) == 2);
   CHECK(err.find("no checkpoint") != std::string::npos);
 }
+
+TEST_CASE("checkpoint: resume keeps --end-time (figure times beyond it) and --vtk", "[checkpoint][cli]") {
+  const fs::path scene = scene_file();
+  const fs::path whole = scratch("end_whole"), out = scratch("end_resumed");
+  const std::string args = " --quiet --vtk --end-time 0.04";  // the figure's t = 0.06 lies beyond it
+  std::string err;
+  REQUIRE(run_cli("run " + scene.string() + args + " --out " + whole.string(), &err) == 0);
+  const pid_t pid =
+      spawn({"run", scene.string(), "--quiet", "--vtk", "--end-time", "0.04", "--out", out.string()});
+  wait_for_file(out / "frames" / "front" / "frame_00002.png", pid);
+  ::kill(pid, SIGINT);
+  REQUIRE(wait_for(pid) == 130);
+  const int code = run_cli("resume " + out.string() + " --quiet", &err);
+  INFO(err);
+  REQUIRE(code == 0);
+  const std::string probes = slurp(out / "probes.csv");
+  CHECK(probes == slurp(whole / "probes.csv"));
+  CHECK(std::count(probes.begin(), probes.end(), '\n') == 12);  // header + t = 0, 0.004, ..., 0.04
+  CHECK(slurp(out / "vtk" / "particles.pvd") == slurp(whole / "vtk" / "particles.pvd"));
+  CHECK(slurp(out / "vtk" / "particles_00010.vtp") == slurp(whole / "vtk" / "particles_00010.vtp"));
+}
