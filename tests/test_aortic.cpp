@@ -1,8 +1,12 @@
 // The parametric aortic root (issue 6): dimensions measured back from the generated particles, the closed
 // valve's orifice, no overlap between parts, clamping, the wall mesh, and bad geometry refused by the loader.
+#include <sys/wait.h>
+
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <numbers>
@@ -350,4 +354,115 @@ TEST_CASE("aortic root report: particle counts and measured dimensions", "[.aort
               << AorticRoot(p).coaptation_height() << ", sag " << AorticRoot(p).belly_sag() << ", lowest "
               << AorticRoot(p).leaflet_lowest() << "\n";
   }
+}
+
+namespace {
+
+json root_scene() {
+  std::ifstream f(std::string(AORTASPH_TEST_DIR) + "/data/aortic_root_geometry.json");
+  return json::parse(f);
+}
+
+std::string load_error(const json& j, const std::vector<std::string>& sets = {}) {
+  try {
+    load_scene_json(j, sets);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("aortic root scenes: shared geometry, per-shape overrides, --set", "[aortic][scene]") {
+  const LoadedScene l = load_scene_json(root_scene(), {"aortic_root.annulus_radius=0.014"});
+  REQUIRE(l.scene.bodies.size() == 5);
+  const Shape& wall = l.scene.bodies[0].shape;
+  CHECK(wall.kind == ShapeKind::AorticRoot);
+  CHECK(wall.aortic_part == AorticPart::Wall);
+  CHECK(wall.aortic.annulus_radius == 0.014);
+  CHECK(l.scene.bodies[4].shape.aortic_part == AorticPart::Leaflet);
+  CHECK(l.scene.bodies[4].shape.aortic_index == 2);
+  CHECK(l.scene.bodies[4].shape.aortic.annulus_radius == 0.014);
+  // Defaults are filled into the shared object (not stj_height / aorta_radius, which follow other values).
+  CHECK(l.resolved["aortic_root"]["wall_layers"] == 3);
+  CHECK(l.resolved["aortic_root"]["sinuses"] == true);
+  CHECK(!l.resolved["aortic_root"].contains("stj_height"));
+
+  // A shape's own key overrides the shared one.
+  json j = root_scene();
+  j["bodies"][2]["shape"]["aortic_root"]["leaflet_layers"] = 2;
+  const LoadedScene o = load_scene_json(j, {});
+  CHECK(o.scene.bodies[2].shape.aortic.leaflet_layers == 2);
+  CHECK(o.scene.bodies[3].shape.aortic.leaflet_layers == 3);
+
+  // Without a shared object every shape carries (and fills) its own parameters.
+  json k = root_scene();
+  k.erase("aortic_root");
+  const LoadedScene n = load_scene_json(k, {"bodies.0.shape.aortic_root.sinuses=false"});
+  CHECK(!n.scene.bodies[0].shape.aortic.sinuses);
+  CHECK(n.scene.bodies[1].shape.aortic.sinuses);
+  CHECK(n.resolved["bodies"][1]["shape"]["aortic_root"]["annulus_radius"] == 0.013);
+}
+
+TEST_CASE("aortic root scenes: impossible geometry is refused naming the parameter",
+          "[aortic][scene][bad-input]") {
+  const json j = root_scene();
+  struct Case {
+    std::vector<std::string> sets;
+    std::string expect;
+  };
+  const std::vector<Case> cases = {
+      {{"aortic_root.commissure_radius=0.019"},
+       "aortic_root.commissure_radius: must be smaller than sinus_radius"},
+      {{"aortic_root.sinus_radius=0.012"},
+       "aortic_root.commissure_radius: must be smaller than sinus_radius"},
+      {{"aortic_root.leaflet_free_edge=0.02"}, "aortic_root.leaflet_free_edge: 0.02 is too short to close"},
+      {{"aortic_root.leaflet_free_edge=0.05"}, "aortic_root.leaflet_free_edge: 0.05 is too long"},
+      {{"aortic_root.leaflet_height=0.01"}, "aortic_root.leaflet_height: 0.01 is too short"},
+      {{"aortic_root.leaflet_height=0.04"}, "aortic_root.leaflet_height: 0.04 is too long"},
+      {{"aortic_root.commissure_angles=[0,240,120]"}, "aortic_root.commissure_angles: must increase"},
+      {{"aortic_root.commissure_angles=[0,20,200]"},
+       "aortic_root.commissure_angles: commissures 0 and 1 are 20"},
+      {{"aortic_root.commissure_angles=[0,120,340]"}, "commissures 2 and 0 are 20 degrees apart"},
+      {{"aortic_root.commissure_angles=[0,120]"}, "aortic_root.commissure_angles: expected 3 numbers, got 2"},
+      {{"aortic_root.stj_height=0.01"}, "aortic_root.stj_height: must not lie below commissure_height"},
+      {{"aortic_root.annulus_radius=-0.01"}, "aortic_root.annulus_radius: must be positive"},
+      {{"aortic_root.lvot_length=0.0005"}, "aortic_root.lvot_length"},
+      {{"aortic_root.sinuses=1"}, "aortic_root.sinuses: expected true or false"},
+      {{"resolution.spacing=0.004"}, "resolution.spacing: spacing 0.004 is too coarse"},
+      {{"bodies.0.shape.aortic_root.commissure_radius=0.02"},
+       "bodies[0].shape.aortic_root.commissure_radius: must be smaller than sinus_radius"},
+      {{"bodies.0.shape.aortic_root.part=valve"}, "bodies[0].shape.aortic_root.part: unknown value 'valve'"},
+      {{"bodies.0.shape.aortic_root.index=1"},
+       "bodies[0].shape.aortic_root.index: only leaflets have an index"},
+      {{"bodies.1.material=wall"}, "bodies[1].material: the aortic root's blood needs a fluid material"},
+      {{"bodies.0.material=blood"}, "bodies[0].material: the aortic root's wall needs a wall material"},
+  };
+  for (const Case& c : cases) {
+    INFO(c.sets[0]);
+    const std::string e = load_error(j, c.sets);
+    CHECK_THAT(e, Catch::Contains(c.expect));
+  }
+  json no_index = j;
+  no_index["bodies"][2]["shape"]["aortic_root"].erase("index");
+  CHECK_THAT(load_error(no_index), Catch::Contains("bodies[2].shape.aortic_root.index: missing"));
+  json typo = j;
+  typo["aortic_root"]["annulus_raduis"] = 0.013;
+  CHECK_THAT(load_error(typo), Catch::Contains("aortic_root.annulus_raduis: unknown key"));
+}
+
+TEST_CASE("aortic root scenes: aortasph check builds the world, bad geometry exits 2", "[aortic][scene]") {
+  const std::string scene = std::string(AORTASPH_TEST_DIR) + "/data/aortic_root_geometry.json";
+  const std::string bin = AORTASPH_BINARY;
+  auto run = [&](const std::string& args) {
+    const int status = std::system((bin + " " + args + " > /dev/null 2>&1").c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  // World refuses bodies closer than dx / 2: check succeeds, so wall, blood and leaflets do not overlap.
+  CHECK(run("check " + scene) == 0);
+  CHECK(run("check " + scene + " --set aortic_root.commissure_angles=[0,100,230]") == 0);
+  CHECK(run("check " + scene + " --set aortic_root.sinuses=false") == 0);
+  CHECK(run("check " + scene + " --set aortic_root.commissure_radius=0.02") == 2);
+  CHECK(run("check " + scene + " --set aortic_root.commissure_angles=[0,10,240]") == 2);
 }
