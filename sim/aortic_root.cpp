@@ -14,6 +14,8 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
+constexpr double kDropExponent = 1.5;  // see leaflet_surface
+
 double deg(double d) {
   return d * kPi / 180.0;
 }
@@ -126,8 +128,13 @@ Vec3 AorticRoot::leaflet_surface(int k, double rho, double s, double inset) cons
   const double ra = cone_radius(ya);
   const double x = (1 - rho) * r_apex * std::cos(t_mid) + rho * ra * std::cos(theta);
   const double z = -(1 - rho) * r_apex * std::sin(t_mid) - rho * ra * std::sin(theta);
-  const double w = std::sin(kPi * s);
-  const double y = y_c_ + (ya - y_c_) * rho - sag_ * std::sin(kPi * rho) * w * w;
+  // Free-edge line plus the attachment's drop below the commissures, fading towards the centre as rho^1.5,
+  // less the belly's sag. The sag's profile across the leaflet, 1 - cos^4(pi s), is level at the free edges
+  // and flat mid-leaflet, so the belly is a rounded trough rather than a fold along the bisector.
+  const double c2 = std::cos(kPi * s) * std::cos(kPi * s);
+  const double edge = y_c_ + (p_.commissure_height - y_c_) * rho;
+  const double y = edge + (ya - p_.commissure_height) * std::pow(rho, kDropExponent) -
+                   sag_ * std::sin(kPi * rho) * (1.0 - c2 * c2);
   return Vec3(x, y, z);
 }
 
@@ -137,7 +144,9 @@ double AorticRoot::midline_length(double sag) const {
   double len = 0.0, r0 = 0.0, y0 = y_c_;
   for (int i = 1; i <= n; ++i) {
     const double rho = static_cast<double>(i) / n;
-    const double r = rho * p_.annulus_radius, y = y_c_ * (1.0 - rho) - sag * std::sin(kPi * rho);
+    const double r = rho * p_.annulus_radius;
+    const double y = y_c_ + (p_.commissure_height - y_c_) * rho -
+                     p_.commissure_height * std::pow(rho, kDropExponent) - sag * std::sin(kPi * rho);
     len += std::hypot(r - r0, y - y0);
     r0 = r;
     y0 = y;
