@@ -139,7 +139,7 @@ Vec3 AorticRoot::leaflet_surface(int k, double rho, double s, double inset) cons
 }
 
 double AorticRoot::midline_length(double sag) const {
-  // Mid-line s = 1/2: r = rho annulus_radius, y = y_c (1 - rho) - sag sin(pi rho).
+  // Mid-line s = 1/2 (without the dx/2 inset): r = rho annulus_radius, y as in leaflet_surface.
   const int n = 2000;
   double len = 0.0, r0 = 0.0, y0 = y_c_;
   for (int i = 1; i <= n; ++i) {

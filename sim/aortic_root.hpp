@@ -3,52 +3,61 @@
 //
 // Geometry, in the root's frame: axis +y, annulus (basal ring) plane y = 0 through `base`; polar angle theta
 // about +y by the right-hand rule, theta = 0 along +x, so a point is base + (r cos theta, y, -r sin theta).
+// s in [0, 1] runs across one sinus / leaflet from commissure k to commissure k+1.
 //
 //  * Lumen radius R(y, theta). Below the annulus (the LV outflow tract) R = annulus_radius. Between the
 //  annulus
-//    and the commissures the root is a truncated cone Rc(y) from annulus_radius to commissure_radius (the
-//    "truncated cone" of the root's anatomy), continued at commissure_radius up to the sinotubular junction
-//    (STJ) and then blended (smoothstep over one commissure radius) into the ascending aorta. Each sinus of
-//    Valsalva bulges out of this cone *above* its leaflet's attachment line y_att(s) and below the STJ:
-//        R = Rc(y) + A sin(pi s) sin(pi (y - y_att(s)) / (H_stj - y_att(s))),
-//    s in [0, 1] across the sinus from one commissure to the next, A chosen so that the largest radius,
-//    mid-sinus at half the STJ height, is sinus_radius. So R = commissure radius at the commissures, the
-//    sinus radius mid-sinus, and the wall below the attachment line (the interleaflet triangles) is the plain
-//    cone.
-//  * Attachment line of leaflet k (the U-shaped "crown" between commissures k and k+1):
-//        y_att(s) = commissure_height (1 - sin(pi s)),  r = Rc(y_att(s)),
-//    lowest (y = 0, r = annulus_radius) mid-sinus, at the commissure height at both commissures.
-//  * Closed leaflet surface over its sector, rho in [0, 1] from the centre to the attachment line:
-//        r = rho Rc(y_att(s)),
-//        y = y_c + (y_att(s) - y_c) rho - S sin(pi rho) sin^2(pi s).
-//    At s = 0 and s = 1 this is the free edge: a straight line in the radial plane of the commissure from
-//    the commissure (r = commissure_radius, y = commissure_height) down to the coaptation point on the axis
-//    (r = 0, y = y_c); the neighbouring leaflet has the same free edge, so the three leaflets meet along
-//    three radial lines. y_c follows from the free-edge length Lf: (Lf / 2)^2 = commissure_radius^2 +
-//    (commissure_height - y_c)^2. The belly sags by S (towards the ventricle), solved so that the mid-line
-//    (s = 1/2) from the nadir to the centre is leaflet_height long. sin^2 makes the surface level across the
-//    coaptation lines, so neighbouring leaflets meet edge to edge with parallel normals.
-//  * Particles: the leaflet is a structured sheet. Rows run parallel to the attachment line, equally spaced
-//    by arc length along each meridian (s = const), the first row dx/2 from the attachment and the last where
-//    r = 0.55 dx / sin(min(sector/2, 90 deg)) (just room for one particle on the bisector); along a row the
-//    points are equally spaced by arc length, the end points dx/2 from the commissure's radial plane. Each
-//    point is repeated leaflet_layers times along the surface normal, centred on the surface (thickness =
-//    layers dx). Particles nearer than 0.45 dx to a neighbour's sector or 0.4 dx to the lumen surface are
-//    left out, so leaflets never overlap each other or the wall (>= 0.9 dx between bodies).
+//    and the commissures the root is a truncated cone Rc(y) from annulus_radius to commissure_radius,
+//    continued at commissure_radius up to the sinotubular junction (STJ) and then blended (smoothstep over
+//    one commissure radius) into the ascending aorta. Each sinus of Valsalva bulges out of this cone *above*
+//    its leaflet's attachment line and below the STJ:
+//        R = Rc(y) + A sin^2(pi s) sin(pi (y - y_att(s)) / (H_stj - y_att(s))),
+//    A chosen so that the largest radius, mid-sinus at half the STJ height, is sinus_radius. So R =
+//    commissure radius at the commissures, the sinus radius mid-sinus, and below the attachment line (the
+//    interleaflet triangles) the wall is the plain cone. With sinuses = false, A = 0 (a graft; a straight
+//    tube when the annulus, commissure and aorta radii are equal).
+//  * Attachment line of each leaflet (the crown between two commissures), on the cone:
+//        y_att(s) = commissure_height cos^2(pi s),  r = Rc(y_att(s)),
+//    at the annulus plane mid-sinus (r = annulus_radius), at the commissure height at both commissures.
+//  * Closed leaflet, rho in [0, 1] from the centre to the attachment line:
+//        (x, z) = (1 - rho) apex + rho attachment point(s),
+//        y = y_c + (commissure_height - y_c) rho + (y_att(s) - commissure_height) rho^1.5
+//            - S sin(pi rho) (1 - cos^4(pi s)).
+//    At s = 0 and s = 1 this is the free edge, a straight line from the commissure (commissure_radius,
+//    commissure_height) to the coaptation point (centre, y_c); y_c follows from the free-edge length Lf:
+//    (Lf / 2)^2 = commissure_radius^2 + (commissure_height - y_c)^2. The three leaflets meet along the three
+//    radial planes of the commissures. The attachment's drop fades towards the centre (rho^1.5) and the belly
+//    sags by S (towards the ventricle), S solved so that the mid-line (s = 1/2), nadir to centre, is
+//    leaflet_height long; the sag's profile 1 - cos^4 is level at the free edges and flat mid-leaflet. Both
+//    s-profiles have zero slope at s = 0, 1, so neighbouring leaflets meet edge to edge with parallel
+//    normals. For particles the surface is inset by dx/2 from the coaptation planes: the apex sits on the
+//    sector's bisector dx/2 from both planes, and the attachment angles run over the sector less dx/2 (at the
+//    commissure radius) at either end, so each free edge runs parallel to its plane at dx/2 and the
+//    neighbouring leaflets' particles face each other dx apart (a closed valve with a gap of one spacing).
+//  * Leaflet particles: a structured sheet. Rows run parallel to the attachment line, equally spaced by arc
+//    length along each meridian (s = const), the first row dx/2 from the attachment, the last the apex;
+//    along a row the points are equally spaced by arc length (about dx). Each point is repeated
+//    leaflet_layers times along the surface normal, centred on the surface (thickness = layers dx); where the
+//    sheet is folded tighter than its thickness, offset points closer than 0.6 dx to one already placed are
+//    left out. Points nearer than 0.45 dx to a neighbour's sector or 0.4 dx to the lumen surface are left out
+//    too, so leaflets never overlap each other or the wall (>= 0.9 dx between bodies).
 //  * Clamp: leaflet particles within 1.75 dx of the lumen surface (about two rows) are flagged clamped.
 //  * Wall: rings of particles at y levels (spaced dx, closer where the sinus wall is steep, so spacing along
 //    the wall stays <= dx), each ring wall_layers deep, layer j at R + (j + 1/2) dx (scaled by the wall's
-//    slope so the layers are dx apart along the normal); ends open.
+//    slope so the layers are dx apart along the normal); rings and layers staggered by half a spacing; ends
+//    open. The mesh is the lumen surface R(y, theta), closed around the axis, normals towards the axis.
 //  * Blood: lattice points (spacing dx, aligned with base) at least dx/2 inside the lumen surface and 0.9 dx
 //    from every leaflet particle, from the bottom of the LVOT to the top of the aorta.
+//
+// All parts of one root must share the body transforms (rotate, translate); they rotate about `base`.
 //
 // Defaults (sim/scene.hpp AorticRootParams): Labrosse, Beller, Robicsek & Thubrikar 2006, "Geometric modeling
 // of functional trileaflet aortic valves: development and clinical applications", J. Biomech. 39:2665-2672:
 // annulus radius 13 mm, commissure radius 12 mm, commissure height 16.8 mm, free edge 30 mm, leaflet height
 // 17 mm. Sinus radius 1.4 x annulus radius = 18.2 mm: the middle of the 1.3-1.5 band of sinus to annulus
-// diameter ratios reported for pressurised roots (Swanson & Clark 1974, Circ. Res. 35:871; the ratio, not
-// the paper's table, is what was checked here) and CT series (e.g. mean sinus 28.5-29.4 mm vs annulus
-// 20.6 mm, Cardiovasc. Metab. Sci. 2021 table 3).
+// ratios of pressurised human roots that issue 6 quotes (Swanson & Clark 1974, "Dimensions and geometric
+// relationships of the human aortic valve as a function of pressure", Circ. Res. 35:871-882; the paper's
+// tables were not at hand here, so the ratio is taken as quoted).
 #pragma once
 
 #include <optional>
