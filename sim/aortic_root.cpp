@@ -116,6 +116,13 @@ double AorticRoot::lumen_radius(double y, double theta) const {
   return cone_radius(y) + bump(s, y);
 }
 
+double AorticRoot::normal_scale(double y, double theta) const {
+  const double h = 1e-7, ht = 1e-6, R = lumen_radius(y, theta);
+  const double r_y = (lumen_radius(y + h, theta) - lumen_radius(y - h, theta)) / (2 * h);
+  const double r_t = (lumen_radius(y, theta + ht) - lumen_radius(y, theta - ht)) / (2 * ht) / R;
+  return std::sqrt(1.0 + r_y * r_y + r_t * r_t);
+}
+
 Vec3 AorticRoot::leaflet_surface(int k, double rho, double s, double inset) const {
   // In projection: from the apex (on the bisector, `inset` from both coaptation planes) to the attachment
   // point, whose angle runs over the sector less `inset` at the commissure radius at either end, so the
@@ -200,11 +207,8 @@ std::vector<Vec3> AorticRoot::wall_points(double dx, SurfaceMesh* mesh) const {
     for (int j = 0; j < p_.wall_layers; ++j) {
       // Layer j's closed curve r(theta), offset so that layers are dx apart along the wall's normal.
       for (int m = 0; m <= nt; ++m) {
-        const double th = phi_[0] + kTwoPi * m / nt, ht = 1e-5;
-        const double R = lumen_radius(y, th);
-        const double r_t = (lumen_radius(y, th + ht) - lumen_radius(y, th - ht)) / (2 * ht) / R;
-        const double ry = r_y(y, th);
-        const double r = R + (j + 0.5) * dx * std::sqrt(1.0 + ry * ry + r_t * r_t);
+        const double th = phi_[0] + kTwoPi * m / nt;
+        const double r = lumen_radius(y, th) + (j + 0.5) * dx * normal_scale(y, th);
         xs[m] = r * std::cos(th);
         zs[m] = -r * std::sin(th);
         len[m] = m == 0 ? 0.0 : len[m - 1] + std::hypot(xs[m] - xs[m - 1], zs[m] - zs[m - 1]);
@@ -379,7 +383,7 @@ std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8
       double s = 0.0;
       if (sector_of(th, s) != k) continue;
       if (sector_distance(r, s * dphi_[k], dphi_[k]) < kSectorMargin * dx) continue;
-      const double depth = lumen_radius(q.y(), th) - r;
+      const double depth = (lumen_radius(q.y(), th) - r) / normal_scale(q.y(), th);
       if (depth < kWallMargin * dx || q.y() < -p_.lvot_length + 0.5 * dx) continue;
       if (crowded(q)) continue;
       placed[key(q, 0, 0, 0)].push_back(q);
@@ -428,7 +432,8 @@ std::vector<Vec3> AorticRoot::blood_points(double dx) const {
       for (int ix = -nr; ix < nr; ++ix) {
         const double x = (ix + 0.5) * dx, y = y_bot + (jy + 0.5) * dx, z = (kz + 0.5) * dx;
         const double r = std::hypot(x, z), th = std::atan2(-z, x);
-        if (r > lumen_radius(y, th) - 0.5 * dx) continue;
+        const double depth = (lumen_radius(y, th) - r) / normal_scale(y, th);
+        if (depth < 0.5 * dx) continue;
         const Vec3 q = p_.base + Vec3(x, y, z);
         if (near_leaflet(q)) continue;
         out.push_back(q);

@@ -41,12 +41,14 @@
 //    sheet is folded tighter than its thickness, offset points closer than 0.6 dx to one already placed are
 //    left out. Points nearer than 0.45 dx to a neighbour's sector or 0.4 dx to the lumen surface are left out
 //    too, so leaflets never overlap each other or the wall (>= 0.9 dx between bodies).
-//  * Clamp: leaflet particles within 1.75 dx of the lumen surface (about two rows) are flagged clamped.
+//  * Clamp: leaflet particles within 1.75 dx of the lumen surface (normal distance, see normal_scale; about
+//    two rows) are flagged clamped.
 //  * Wall: rings of particles at y levels (spaced dx, closer where the sinus wall is steep, so spacing along
 //    the wall stays <= dx), each ring wall_layers deep, layer j at R + (j + 1/2) dx (scaled by the wall's
 //    slope so the layers are dx apart along the normal); rings and layers staggered by half a spacing; ends
 //    open. The mesh is the lumen surface R(y, theta), closed around the axis, normals towards the axis.
-//  * Blood: lattice points (spacing dx, aligned with base) at least dx/2 inside the lumen surface and 0.9 dx
+//  * Blood: lattice points (spacing dx, aligned with base) at least dx/2 inside the lumen surface (along its
+//    normal) and 0.9 dx
 //    from every leaflet particle, from the bottom of the LVOT to the top of the aorta.
 //
 // All parts of one root must share the body transforms (rotate, translate); they rotate about `base`.
@@ -89,6 +91,9 @@ class AorticRoot {
   const AorticRootParams& params() const { return p_; }
   // Lumen radius at height y above the annulus plane and polar angle theta [rad].
   double lumen_radius(double y, double theta) const;
+  // Radial distance per unit distance along the lumen surface's normal at (y, theta): sqrt(1 + R_y^2 +
+  // (R_theta / R)^2). Radial gaps divided by it are (to first order) normal distances to the wall.
+  double normal_scale(double y, double theta) const;
   // Radius of the plain cone (no sinus) at height y.
   double cone_radius(double y) const;
   // Leaflet k's sector: first commissure angle [rad] and its width [rad].

@@ -255,7 +255,7 @@ TEST_CASE("aortic root: leaflets are layered sheets clamped along their attachme
     std::size_t n_clamped = 0, second_row = 0;
     for (std::size_t i = 0; i < l.points.size(); ++i) {
       const Polar a = polar(l.points[i], p.base);
-      const double depth = root.lumen_radius(a.y, a.theta) - a.r;
+      const double depth = (root.lumen_radius(a.y, a.theta) - a.r) / root.normal_scale(a.y, a.theta);
       if (l.clamped[i]) {
         ++n_clamped;
         CHECK(depth < 1.75 * dx);
@@ -463,6 +463,8 @@ TEST_CASE("aortic root scenes: aortasph check builds the world, bad geometry exi
   CHECK(run("check " + scene) == 0);
   CHECK(run("check " + scene + " --set aortic_root.commissure_angles=[0,100,230]") == 0);
   CHECK(run("check " + scene + " --set aortic_root.sinuses=false") == 0);
+  // Narrow sinuses have steep walls: blood and leaflets keep their distance along the wall's normal.
+  CHECK(run("check " + scene + " --set aortic_root.commissure_angles=[0,40,80]") == 0);
   CHECK(run("check " + scene + " --set aortic_root.commissure_radius=0.02") == 2);
   CHECK(run("check " + scene + " --set aortic_root.commissure_angles=[0,10,240]") == 2);
 }
