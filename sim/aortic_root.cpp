@@ -406,8 +406,13 @@ std::vector<Vec3> AorticRoot::blood_points(double dx) const {
            (static_cast<int64_t>(c.y()) + (1 << 20)) * (int64_t(1) << 21) +
            (static_cast<int64_t>(c.z()) + (1 << 20));
   };
+  double leaf_lo = 1e300, leaf_hi = -1e300;  // heights (relative to base) the leaflets span, +- dx
   for (int k = 0; k < 3; ++k)
-    for (const Vec3& q : leaflet_points(k, dx, nullptr)) grid[cell(q)].push_back(q);
+    for (const Vec3& q : leaflet_points(k, dx, nullptr)) {
+      grid[cell(q)].push_back(q);
+      leaf_lo = std::min(leaf_lo, q.y() - p_.base.y() - dx);
+      leaf_hi = std::max(leaf_hi, q.y() - p_.base.y() + dx);
+    }
   auto near_leaflet = [&](const Vec3& q) {
     for (int a = -1; a <= 1; ++a)
       for (int b = -1; b <= 1; ++b)
@@ -431,11 +436,14 @@ std::vector<Vec3> AorticRoot::blood_points(double dx) const {
     for (int jy = 0; jy < ny; ++jy)
       for (int ix = -nr; ix < nr; ++ix) {
         const double x = (ix + 0.5) * dx, y = y_bot + (jy + 0.5) * dx, z = (kz + 0.5) * dx;
-        const double r = std::hypot(x, z), th = std::atan2(-z, x);
-        const double depth = (lumen_radius(y, th) - r) / normal_scale(y, th);
-        if (depth < 0.5 * dx) continue;
+        const double r = std::hypot(x, z);
+        if (r > r_max) continue;
+        const double th = std::atan2(-z, x);
+        // Normal depth <= radial depth; the slope factor only where the radial depth leaves a doubt.
+        const double radial = lumen_radius(y, th) - r;
+        if (radial < 0.5 * dx || (radial < 4 * dx && radial / normal_scale(y, th) < 0.5 * dx)) continue;
         const Vec3 q = p_.base + Vec3(x, y, z);
-        if (near_leaflet(q)) continue;
+        if (y >= leaf_lo && y <= leaf_hi && near_leaflet(q)) continue;
         out.push_back(q);
       }
   return out;

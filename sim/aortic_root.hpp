@@ -48,8 +48,7 @@
 //    slope so the layers are dx apart along the normal); rings and layers staggered by half a spacing; ends
 //    open. The mesh is the lumen surface R(y, theta), closed around the axis, normals towards the axis.
 //  * Blood: lattice points (spacing dx, aligned with base) at least dx/2 inside the lumen surface (along its
-//    normal) and 0.9 dx
-//    from every leaflet particle, from the bottom of the LVOT to the top of the aorta.
+//    normal) and 0.9 dx from every leaflet particle, from the bottom of the LVOT to the top of the aorta.
 //
 // All parts of one root must share the body transforms (rotate, translate); they rotate about `base`.
 //
