@@ -330,6 +330,17 @@ TEST_CASE("aortic root: orifice_area sees an open leaflet", "[aortic]") {
   CHECK(orifice_area(lattice, dx, Vec3::Zero(), Vec3::UnitY(), 0.01) == 0.0);
 }
 
+TEST_CASE("aortic root: generation is deterministic", "[aortic]") {
+  AorticRootParams p;
+  p.commissure_angles = {5.0, 130.0, 250.0};
+  for (AorticPart part : {AorticPart::Wall, AorticPart::Blood, AorticPart::Leaflet}) {
+    const ShapeSample a = sample_aortic_root(p, part, 1, 0.001), b = sample_aortic_root(p, part, 1, 0.001);
+    REQUIRE(a.points.size() == b.points.size());
+    CHECK(std::equal(a.points.begin(), a.points.end(), b.points.begin()));
+    CHECK(a.clamped == b.clamped);
+  }
+}
+
 TEST_CASE("aortic root: bending-equivalent leaflet modulus", "[aortic]") {
   // E t^3 kept: 2 MPa at 0.4 mm equals 4.74 kPa at 3 mm.
   CHECK(bending_equivalent_modulus(2e6, 0.4e-3, 3e-3) == Approx(2e6 * std::pow(0.4 / 3.0, 3)));
