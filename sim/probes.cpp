@@ -65,6 +65,9 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
       case ProbeType::Momentum:
         add_columns(columns_, pr.name, {"px", "py", "pz", "lx", "ly", "lz"});
         break;
+      case ProbeType::OpenBoundary:
+        add_columns(columns_, pr.name, {"volume_in", "volume_out", "volume_inside", "prescribed_rate"});
+        break;
       case ProbeType::OrificeArea:
         throw SetupError("probes[" + std::to_string(k) + "] '" + pr.name +
                          "': orifice_area needs an elastic valve, which this version cannot simulate yet");
@@ -211,6 +214,19 @@ std::vector<double> ProbeSet::measure(const World& world) const {
             },
             [](double a, double b) { return a + b; });
         out.push_back(q / d);
+        break;
+      }
+      case ProbeType::OpenBoundary: {
+        // Cumulative volumes through the open boundaries (m / rho of each particle as it crossed a disc), the
+        // fluid volume inside now (sum of m / rho over fluid particles, buffers excluded) and the prescribed
+        // inflow rate now. Volume balance: volume_in - volume_out = change of volume_inside, up to the
+        // fluid's compression (weakly compressible) and particles that leave the domain elsewhere.
+        const OpenBoundaries& ob = world.open_boundaries();
+        const double inside = parallel_reduce(
+            n, 0.0, [&](std::size_t i) { return P.kind[i] == Kind::Fluid ? P.m[i] / P.rho[i] : 0.0; },
+            [](double a, double b) { return a + b; });
+        out.insert(out.end(), {ob.state().volume_in, ob.state().volume_out, inside,
+                               ob.prescribed_inflow_rate(world.time())});
         break;
       }
       case ProbeType::OrificeArea:

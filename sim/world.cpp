@@ -163,6 +163,9 @@ World::World(const Scene& scene)
                          ": particles closer than half a spacing");
     }
 
+  // Inflow buffer particles join the bodies; fluid already beyond an outlet disc becomes outflow buffer.
+  if (!scene_.open_boundaries.empty()) open_.setup(scene_, fluid_, P_);
+
   for (std::size_t i = 0; i < P_.size(); ++i)
     if (P_.kind[i] != Kind::Wall) ++moving_at_start_;
   speed_limit_ = scene_.max_speed > 0.0 ? scene_.max_speed : (max_c0_ > 0.0 ? 2.0 * max_c0_ : 1e3);
@@ -274,6 +277,16 @@ void World::step(double dt) {
 
   t0 = Clock::now();
   integrate(dt);
+  profile_.integrate += seconds_since(t0);
+
+  // Open boundaries (sim/open_boundary.hpp): buffers move, particles that crossed an inlet or outlet disc
+  // change role, are created at inflows and removed at outflows (those never count as leaving the domain).
+  // Created or removed particles invalidate the neighbour lists.
+  t0 = Clock::now();
+  if (!open_.empty() && open_.update(P_, nb_, kernel_, gravity_, time_ + dt, dt)) lists_valid_ = false;
+  profile_.open_boundary += seconds_since(t0);
+
+  t0 = Clock::now();
   check_and_remove(dt);
   profile_.integrate += seconds_since(t0);
 
