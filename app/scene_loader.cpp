@@ -458,6 +458,8 @@ class Loader {
   OpenBoundarySpec open_boundary(json& j, const std::string& path, const Scene& s) {
     if (!j.is_object()) fail(path, "expected an object, got " + type_name(j));
     const std::string type = j.contains("type") && j["type"].is_string() ? j["type"].get<std::string>() : "";
+    if (j.contains("type") && type != "inflow" && type != "outflow")
+      fail(path + ".type", "unknown value " + j["type"].dump() + " (expected one of: inflow, outflow)");
     std::vector<std::string> keys = {"name", "type", "point", "normal", "radius", "layers"};
     if (type == "inflow") keys.insert(keys.end(), {"body", "velocity", "profile"});
     if (type == "outflow") keys.insert(keys.end(), {"pressure"});

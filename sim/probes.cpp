@@ -66,7 +66,9 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
         add_columns(columns_, pr.name, {"px", "py", "pz", "lx", "ly", "lz"});
         break;
       case ProbeType::OpenBoundary:
-        add_columns(columns_, pr.name, {"volume_in", "volume_out", "volume_inside", "prescribed_rate"});
+        add_columns(columns_, pr.name,
+                    {"volume_in", "volume_out", "volume_inside", "prescribed_rate", "mass_in", "mass_out",
+                     "mass_inside"});
         break;
       case ProbeType::OrificeArea:
         throw SetupError("probes[" + std::to_string(k) + "] '" + pr.name +
@@ -219,14 +221,24 @@ std::vector<double> ProbeSet::measure(const World& world) const {
       case ProbeType::OpenBoundary: {
         // Cumulative volumes through the open boundaries (m / rho of each particle as it crossed a disc), the
         // fluid volume inside now (sum of m / rho over fluid particles, buffers excluded) and the prescribed
-        // inflow rate now. Volume balance: volume_in - volume_out = change of volume_inside, up to the
-        // fluid's compression (weakly compressible) and particles that leave the domain elsewhere.
+        // inflow rate now; then the same as masses. Volume balance: volume_in - volume_out = change of
+        // volume_inside, up to the fluid's change of density (weakly compressible); mass balance: exact, up
+        // to particles that leave the domain elsewhere.
         const OpenBoundaries& ob = world.open_boundaries();
-        const double inside = parallel_reduce(
-            n, 0.0, [&](std::size_t i) { return P.kind[i] == Kind::Fluid ? P.m[i] / P.rho[i] : 0.0; },
-            [](double a, double b) { return a + b; });
-        out.insert(out.end(), {ob.state().volume_in, ob.state().volume_out, inside,
-                               ob.prescribed_inflow_rate(world.time())});
+        struct VM {
+          double v = 0, m = 0;
+        };
+        const VM inside = parallel_reduce(
+            n, VM{},
+            [&](std::size_t i) {
+              return P.kind[i] == Kind::Fluid ? VM{P.m[i] / P.rho[i], P.m[i]} : VM{};
+            },
+            [](const VM& a, const VM& b) {
+              return VM{a.v + b.v, a.m + b.m};
+            });
+        const OpenBoundaryState& st = ob.state();
+        out.insert(out.end(), {st.volume_in, st.volume_out, inside.v, ob.prescribed_inflow_rate(world.time()),
+                               st.mass_in, st.mass_out, inside.m});
         break;
       }
       case ProbeType::OrificeArea:
