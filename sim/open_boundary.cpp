@@ -215,22 +215,34 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
   if (zones_.empty()) return false;
   const std::size_t n = P.size();
 
-  // Outflow velocity: Shepard average of the fluid particles within the support (zero gradient); kept as it
-  // is where no fluid particle is near. Reads fluid velocities only, writes outflow ones: a gather.
+  // Outflow velocity, zero gradient along the axis: in order of increasing distance from the disc, each
+  // outflow particle takes the Shepard average of its fluid neighbours and of the outflow neighbours nearer
+  // the disc (already updated), so the fluid's velocity at the disc carries through the whole buffer; kept
+  // as it is where no such neighbour is near. Serial, in a fixed order (distance, then index): a few layers
+  // of particles only.
   const auto& idx = nb.index();
-  parallel_for_dynamic(n, [&](std::size_t i) {
-    if (P.kind[i] != Kind::Outflow) return;
+  std::vector<std::pair<double, uint32_t>> order;
+  for (std::size_t i = 0; i < n; ++i)
+    if (P.kind[i] == Kind::Outflow)
+      if (const int k = zone_of(P.x[i], Kind::Outflow); k >= 0)
+        order.emplace_back(zones_[k].axial(P.x[i]), static_cast<uint32_t>(i));
+  std::sort(order.begin(), order.end());
+  std::vector<int32_t> rank(order.empty() ? 0 : n, -1);
+  for (std::size_t r = 0; r < order.size(); ++r) rank[order[r].second] = static_cast<int32_t>(r);
+  for (std::size_t r = 0; r < order.size(); ++r) {
+    const uint32_t i = order[r].second;
     double sw = 0.0;
     Vec3 sv = Vec3::Zero();
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
-      if (P.kind[j] != Kind::Fluid) continue;
+      if (P.kind[j] != Kind::Fluid && !(P.kind[j] == Kind::Outflow && rank[j] >= 0 && rank[j] < rank[i]))
+        continue;
       const double W = K.W((P.x[i] - P.x[j]).norm()) * P.m[j] / P.rho[j];
       sw += W;
       sv += W * P.v[j];
     }
     if (sw > 0.0) P.v[i] = sv / sw;
-  });
+  }
 
   // Buffers move: inflow with the prescribed velocity at t_new, outflow with its own (symplectic Euler as the
   // fluid: x(t + dt) = x + dt v(t + dt)).

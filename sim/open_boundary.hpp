@@ -18,11 +18,10 @@
 //     particle is created `layers` spacings behind it, in the same lattice column (the lattice feeds on
 //     without gaps).
 //   - Outflow (pressure Dirichlet, velocity Neumann): a fluid particle that crosses the disc becomes an
-//   outflow
-//     particle; its pressure is the prescribed p(t) plus the hydrostatic difference, its density from the
-//     equation of state, and its velocity the Shepard average of the fluid particles within the kernel
-//     support (kept as it is once no fluid particle is near). It is removed when it passes the buffer's far
-//     face, and turns back into fluid if it returns across the disc.
+//     outflow particle. Its pressure is the prescribed p(t) plus the hydrostatic difference, its density
+//     from the equation of state; its velocity is carried through the buffer from the fluid (Shepard average
+//     of the fluid neighbours and of the outflow neighbours nearer the disc, layer by layer). It is removed
+//     when it passes the buffer's far face, and turns back into fluid if it returns across the disc.
 //   - Fluid particles that flow backwards into an inflow buffer are removed (counted as volume out).
 //
 // Every change of role, creation and removal is decided per particle and applied in one serial pass in index

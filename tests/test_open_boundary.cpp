@@ -33,6 +33,7 @@ struct TubeSetup {
   bool parabolic = false;
   TimeSeries pressure{{}, {0.0}};
   double background = 0.0;  // background pressure of the fluid [Pa]
+  Vec3 gravity = Vec3::Zero();
 };
 
 Material blood(double c0) {
@@ -52,7 +53,7 @@ Scene tube_scene(const TubeSetup& t) {
   Scene s;
   s.name = "tube_flow";
   s.spacing = dx;
-  s.gravity = Vec3::Zero();
+  s.gravity = t.gravity;
   s.domain = {Vec3(-R - 6 * dx, -D - 4 * dx, -R - 6 * dx), Vec3(R + 6 * dx, L + D + 4 * dx, R + 6 * dx)};
   s.t_end = 1.0;
   s.max_dt = 1e-3;
@@ -144,8 +145,9 @@ struct Row {
       p_in;
 };
 
-// Runs the scene to t_end, one probe row every `every` seconds.
-std::vector<Row> run(const Scene& s, double t_end, double every) {
+// Runs the scene to t_end, one probe row every `every` seconds; the buffers' particle counts at the end.
+std::vector<Row> run(const Scene& s, double t_end, double every, std::size_t* inflow = nullptr,
+                     std::size_t* outflow = nullptr) {
   World w(s);
   ProbeSet probes(s, w);
   std::vector<Row> rows;
@@ -158,6 +160,8 @@ std::vector<Row> run(const Scene& s, double t_end, double every) {
     w.advance_to(t, [] { return true; });
     sample();
   }
+  if (inflow) *inflow = w.count(Kind::Inflow);
+  if (outflow) *outflow = w.count(Kind::Outflow);
   if (std::getenv("OB_DEBUG")) {
     for (const auto& [name, sec] : w.profile().phases()) printf("%s %.3f\n", name.c_str(), sec);
     printf("steps %ld builds %ld n %zu left %zu\n", w.steps(), w.list_builds(), w.particles().size(),
@@ -200,7 +204,12 @@ TEST_CASE("tube flow: the mid-tube flow rate matches the prescribed inflow", "[o
   t.initial_velocity = 0.1;  // the paper's set-up: the column already moves, the inflow keeps it going
   const Scene s = tube_scene(t);
   const double t_end = 0.1;
-  const auto rows = run(s, t_end, 0.0025);
+  std::size_t inflow = 0, outflow = 0;
+  const auto rows = run(s, t_end, 0.0025, &inflow, &outflow);
+  // The inflow buffer keeps its 4 layers of 52 columns; the outflow buffer neither empties nor piles up.
+  CHECK(inflow == 4 * 52);
+  CHECK(outflow > 0.8 * 4 * 52);
+  CHECK(outflow < 1.2 * 4 * 52);
   const double prescribed = rows.back().prescribed;
   // 52 columns of dx^2 at 0.1 m/s.
   CHECK(prescribed == Approx(0.1 * 52 * t.dx * t.dx).epsilon(1e-12));
@@ -275,6 +284,35 @@ TEST_CASE("tube flow: the pressure next to the outlet is the prescribed one", "[
   const double p = mean(rows, 0.032, 0.096, &Row::p_out);
   INFO("mean pressure near the outlet " << p << " Pa, prescribed " << p_out << " Pa");
   CHECK(std::abs(p / p_out - 1.0) < 0.05);
+}
+
+TEST_CASE("tube flow under gravity: a closed inflow holds the column at hydrostatic pressure", "[open]") {
+  TubeSetup t;
+  t.gravity = Vec3(0, -9.81, 0);
+  // c0 >= 10 sqrt(g H) (the usual weakly compressible rule): at c0 = 2 m/s the column's compression (4 %)
+  // steepens the discrete hydrostatic gradient by 7 %, at 4 m/s by 2 %.
+  t.c0 = 4.0;
+  t.velocity = TimeSeries{{}, {0.0}};
+  t.background = 100.0;
+  // The column starts hydrostatic below its top (p = rho g depth, World), which lies `layers` spacings above
+  // the outlet disc: the outlet holds the pressure the column has there, so that nothing moves from the
+  // start.
+  const double rho_g = 1060.0 * 9.81;
+  t.pressure = TimeSeries{{}, {rho_g * t.layers * t.dx}};
+  const Scene s = tube_scene(t);
+  const auto rows = run(s, 0.064, 0.002);
+  // The probes sit 3 spacings inside each disc, 10 spacings apart: rho g dy = 104 Pa.
+  const double dp = mean(rows, 0.032, 0.064, &Row::p_in) - mean(rows, 0.032, 0.064, &Row::p_out);
+  const double expect = 1060.0 * 9.81 * 10 * t.dx;
+  INFO("p_in - p_out = " << dp << " Pa, rho g dy = " << expect << " Pa");
+  CHECK(std::abs(dp / expect - 1.0) < 0.05);
+  // At the outlet, the prescribed pressure plus rho g 3 dx.
+  const double p_out = mean(rows, 0.032, 0.064, &Row::p_out);
+  const double p_expect = rho_g * (t.layers + 3) * t.dx;
+  INFO("p near the outlet " << p_out << " Pa, expected " << p_expect);
+  CHECK(std::abs(p_out - p_expect) < 0.05 * expect);
+  // Nothing flows.
+  CHECK(std::abs(mean(rows, 0.032, 0.064, &Row::q_mid)) < 0.02 * 0.1 * 52 * t.dx * t.dx);
 }
 
 TEST_CASE("tube flow: a parabolic inflow stays roughly parabolic mid-tube", "[open]") {
