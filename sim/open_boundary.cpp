@@ -37,17 +37,12 @@ double OpenBoundaries::Zone::inflow_speed(const Vec3& x, double t) const {
   return V * std::max(1.0 - r * r, 0.0) / profile_mean;
 }
 
-void OpenBoundaries::setup(const Scene& scene, const std::vector<FluidParams>& fluid, Particles& P) {
+void OpenBoundaries::configure(const Scene& scene, const std::vector<FluidParams>& fluid) {
   fluid_ = fluid;
   dx_ = scene.spacing;
   support_ = 2.0 * scene.smoothing_ratio * scene.spacing;
   const double dx = dx_;
-  uint32_t next = 0;
-  for (std::size_t i = 0; i < P.size(); ++i) next = std::max(next, P.id[i] + 1);
-  state_ = OpenBoundaryState{};
-  state_.next_id = next;
-
-  const std::size_t first_buffer = P.size();
+  zones_.clear();
   for (std::size_t k = 0; k < scene.open_boundaries.size(); ++k) {
     const OpenBoundarySpec& s = scene.open_boundaries[k];
     Zone z;
@@ -70,13 +65,11 @@ void OpenBoundaries::setup(const Scene& scene, const std::vector<FluidParams>& f
       if (s.body < 0 || s.body >= static_cast<int>(scene.bodies.size()) ||
           scene.materials.at(scene.bodies[s.body].material).type != MaterialType::Fluid)
         throw SetupError(where(k, s) + ": an inflow must feed a fluid body");
-      const Body& body = scene.bodies[s.body];
-      z.material = body.material;
-      const FluidParams& fp = fluid_.at(z.material);
+      z.material = scene.bodies[s.body].material;
       // Lattice columns across the disc, laid out like the tube's (shapes.cpp), so that an inlet at a tube's
       // base continues the tube's lattice.
       const int nr = static_cast<int>(std::ceil(s.radius / dx));
-      std::vector<Vec3> columns;
+      std::vector<Vec3>& columns = z.columns;
       double sum_profile = 0.0;
       for (int j = -nr; j < nr; ++j)
         for (int i = -nr; i < nr; ++i) {
@@ -91,21 +84,37 @@ void OpenBoundaries::setup(const Scene& scene, const std::vector<FluidParams>& f
                          " holds no particle column at spacing " + std::to_string(dx));
       z.area = static_cast<double>(columns.size()) * dx * dx;
       z.profile_mean = sum_profile / static_cast<double>(columns.size());
-      for (int layer = 0; layer < s.layers; ++layer)
-        for (const Vec3& c : columns) {
-          const std::size_t i = P.size();
-          P.resize(i + 1);
-          P.x[i] = c - (layer + 0.5) * dx * z.spec.normal;
-          P.x0[i] = P.x[i];
-          P.kind[i] = Kind::Inflow;
-          P.body[i] = static_cast<uint16_t>(s.body);
-          P.material[i] = static_cast<uint16_t>(z.material);
-          P.id[i] = state_.next_id++;
-          P.m[i] = fp.rho0 * dx * dx * dx;
-          P.rho[i] = fp.rho0;
-        }
     }
     zones_.push_back(z);
+  }
+}
+
+void OpenBoundaries::setup(const Scene& scene, const std::vector<FluidParams>& fluid, Particles& P) {
+  configure(scene, fluid);
+  const double dx = dx_;
+  uint32_t next = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) next = std::max(next, P.id[i] + 1);
+  state_ = OpenBoundaryState{};
+  state_.next_id = next;
+
+  // The inflow buffers: `layers` lattice layers behind each inlet disc.
+  const std::size_t first_buffer = P.size();
+  for (const Zone& z : zones_) {
+    if (z.spec.type != OpenBoundaryType::Inflow) continue;
+    const FluidParams& fp = fluid_.at(z.material);
+    for (int layer = 0; layer < z.spec.layers; ++layer)
+      for (const Vec3& c : z.columns) {
+        const std::size_t i = P.size();
+        P.resize(i + 1);
+        P.x[i] = c - (layer + 0.5) * dx * z.spec.normal;
+        P.x0[i] = P.x[i];
+        P.kind[i] = Kind::Inflow;
+        P.body[i] = static_cast<uint16_t>(z.spec.body);
+        P.material[i] = static_cast<uint16_t>(z.material);
+        P.id[i] = state_.next_id++;
+        P.m[i] = fp.rho0 * dx * dx * dx;
+        P.rho[i] = fp.rho0;
+      }
   }
 
   // Inflow buffers must not overlap bodies (nor each other): particles closer than half a spacing.
@@ -164,6 +173,7 @@ double OpenBoundaries::prescribed_inflow_rate(double t) const {
 
 void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) const {
   const std::size_t n = P.size();
+  const double dx3 = dx_ * dx_ * dx_;
   // Inflow pressure: zero gradient along the axis. The volume-weighted mean pressure of the fluid in a slab
   // one kernel support deep inside the disc, applied at the slab's centroid, plus the hydrostatic difference.
   struct Slab {
@@ -207,6 +217,12 @@ void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) const {
     }
     P.rho[i] = fp.density(p);
     P.p[i] = fp.pressure(P.rho[i]);  // density() clamps far-negative pressures: keep the pair consistent
+    // Inflow particles sit on the lattice, one per dx^3: their mass follows their density, so that
+    // m / rho = dx^3 and the fluid they become has the density its spacing says. (With m = rho0 dx^3 under
+    // pressure, each entering particle would claim less volume than it fills, the fluid's density would drift
+    // above its particle number density, and the column would push out more than comes in.) The volume flow
+    // into the domain is then exactly V A, the mass flow rho V A.
+    if (P.kind[i] == Kind::Inflow) P.m[i] = P.rho[i] * dx3;
   });
 }
 
@@ -221,16 +237,22 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
   // as it is where no such neighbour is near. Serial, in a fixed order (distance, then index): a few layers
   // of particles only.
   const auto& idx = nb.index();
-  std::vector<std::pair<double, uint32_t>> order;
+  struct Item {
+    double axial;
+    uint32_t i;
+    int zone;
+    bool operator<(const Item& o) const { return axial < o.axial || (axial == o.axial && i < o.i); }
+  };
+  std::vector<Item> order;
   for (std::size_t i = 0; i < n; ++i)
     if (P.kind[i] == Kind::Outflow)
       if (const int k = zone_of(P.x[i], Kind::Outflow); k >= 0)
-        order.emplace_back(zones_[k].axial(P.x[i]), static_cast<uint32_t>(i));
+        order.push_back({zones_[k].axial(P.x[i]), static_cast<uint32_t>(i), k});
   std::sort(order.begin(), order.end());
   std::vector<int32_t> rank(order.empty() ? 0 : n, -1);
-  for (std::size_t r = 0; r < order.size(); ++r) rank[order[r].second] = static_cast<int32_t>(r);
+  for (std::size_t r = 0; r < order.size(); ++r) rank[order[r].i] = static_cast<int32_t>(r);
   for (std::size_t r = 0; r < order.size(); ++r) {
-    const uint32_t i = order[r].second;
+    const uint32_t i = order[r].i;
     double sw = 0.0;
     Vec3 sv = Vec3::Zero();
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
@@ -241,7 +263,10 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
       sw += W;
       sv += W * P.v[j];
     }
-    if (sw > 0.0) P.v[i] = sv / sw;
+    // Only the normal component: the flow leaves along the outlet's axis, and buffer particles, which feel no
+    // wall, must not drift out of the buffer sideways.
+    const Vec3& nrm = zones_[order[r].zone].spec.normal;
+    if (sw > 0.0) P.v[i] = (sv.dot(nrm) / sw) * nrm;
   }
 
   // Buffers move: inflow with the prescribed velocity at t_new, outflow with its own (symplectic Euler as the
@@ -268,6 +293,7 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
       P.a[i] = Vec3::Zero();
       P.x[i] += dt * P.v[i];
       const int k = zone_of(P.x[i], Kind::Outflow);
+      zone[i] = k;
       if (k < 0) {
         action[i] = kRemove;  // left its buffer sideways or beyond the far face
         return;
@@ -281,8 +307,11 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
       if (const int k = zone_of(P.x[i], Kind::Outflow);
           k >= 0 && zones_[k].axial(P.x[i]) >= 0.0 && zones_[k].radial(P.x[i]) <= zones_[k].spec.radius)
         action[i] = kFluidToOutflow;
+      // Fluid pushed back into an inflow buffer (a closed or slow inlet with the column sloshing) is removed
+      // only once it is more than a spacing deep, past the buffer's first layer: small back-and-forth motion
+      // across the disc must not drain the column.
       else if (const int m = zone_of(P.x[i], Kind::Inflow);
-               m >= 0 && zones_[m].axial(P.x[i]) < 0.0 && zones_[m].radial(P.x[i]) < zones_[m].spec.radius)
+               m >= 0 && zones_[m].axial(P.x[i]) < -dx_ && zones_[m].radial(P.x[i]) < zones_[m].spec.radius)
         action[i] = kRemoveBackflow;
     }
   });
@@ -293,7 +322,8 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
     switch (action[i]) {
       case kNone:
         break;
-      case kInflowToFluid: {
+      case kInflowToFluid:
+      case kOutflowToFluid: {
         P.kind[i] = Kind::Fluid;
         state_.volume_in += P.m[i] / P.rho[i];
         state_.mass_in += P.m[i];
@@ -301,18 +331,21 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
         if (k < 0) break;
         if (state_.next_id == std::numeric_limits<uint32_t>::max())
           throw InstabilityError("open boundaries: particle ids exhausted");
-        // The new buffer particle: `layers` spacings behind, in the same column.
+        // The new buffer particle, `layers` spacings behind along the flow: behind the inlet disc, or at the
+        // outlet buffer's far face when fluid flows back in through an outlet (the buffer stays full; without
+        // this, every back-and-forth swing would lose the particles that passed the far face).
         const Zone& z = zones_[k];
         const std::size_t j = P.size();
         P.resize(j + 1);
-        P.x[j] = P.x[i] - z.depth * z.spec.normal;
+        const bool inflow = action[i] == kInflowToFluid;
+        P.x[j] = P.x[i] + (inflow ? -z.depth : z.depth) * z.spec.normal;
         P.x0[j] = P.x[j];
+        P.kind[j] = inflow ? Kind::Inflow : Kind::Outflow;
         P.v[j] = P.v[i];
         P.v_wall[j] = P.v[i];
         P.rho[j] = P.rho[i];
         P.p[j] = P.p[i];
         P.m[j] = P.m[i];
-        P.kind[j] = Kind::Inflow;
         P.body[j] = P.body[i];
         P.material[j] = P.material[i];
         P.id[j] = state_.next_id++;
@@ -324,11 +357,6 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
         P.a[i] = Vec3::Zero();
         state_.volume_out += P.m[i] / P.rho[i];
         state_.mass_out += P.m[i];
-        break;
-      case kOutflowToFluid:
-        P.kind[i] = Kind::Fluid;
-        state_.volume_in += P.m[i] / P.rho[i];
-        state_.mass_in += P.m[i];
         break;
       case kRemove:
         ++removed;

@@ -19,10 +19,14 @@
 //     without gaps).
 //   - Outflow (pressure Dirichlet, velocity Neumann): a fluid particle that crosses the disc becomes an
 //     outflow particle. Its pressure is the prescribed p(t) plus the hydrostatic difference, its density
-//     from the equation of state; its velocity is carried through the buffer from the fluid (Shepard average
-//     of the fluid neighbours and of the outflow neighbours nearer the disc, layer by layer). It is removed
-//     when it passes the buffer's far face, and turns back into fluid if it returns across the disc.
-//   - Fluid particles that flow backwards into an inflow buffer are removed (counted as volume out).
+//     from the equation of state; its velocity is carried through the buffer from the fluid (normal component
+//     of the Shepard average of the fluid neighbours and of the outflow neighbours nearer the disc, layer by
+//     layer). It is removed
+//     when it passes the buffer's far face. If it returns across the disc (backflow) it turns back into
+//     fluid and a new outflow particle is created `layers` spacings further out, so the buffer stays full
+//     through back-and-forth flow.
+//   - Fluid particles that flow backwards more than one spacing into an inflow buffer are removed (counted as
+//     volume out).
 //
 // Every change of role, creation and removal is decided per particle and applied in one serial pass in index
 // order, new particles are appended in that order with ids from a counter: runs stay bitwise reproducible for
@@ -47,7 +51,7 @@ struct OpenBoundaryState {
   double volume_out = 0.0;  // cumulative volume that left it through an open boundary [m^3]
   double mass_in = 0.0;     // the same as masses [kg]
   double mass_out = 0.0;
-  uint64_t created = 0;  // particles created at inflows
+  uint64_t created = 0;  // particles created (inflows feeding, outflows refilled after backflow)
   uint64_t removed = 0;  // particles removed at outflows and inflows
 };
 
@@ -59,6 +63,10 @@ class OpenBoundaries {
   // outflow buffer into outflow particles, and imposes the buffers' state at time 0. Throws SetupError where
   // a buffer overlaps a body or lies outside the domain. fluid: per-material parameters (World::fluid_).
   void setup(const Scene& scene, const std::vector<FluidParams>& fluid, Particles& P);
+
+  // Only the read-only part of setup() (geometry, lattice columns, checks), no particle and no state: for a
+  // world restored from a checkpoint, whose particles already hold the buffers; restore state() after it.
+  void configure(const Scene& scene, const std::vector<FluidParams>& fluid);
 
   bool empty() const { return zones_.empty(); }
 
@@ -84,6 +92,7 @@ class OpenBoundaries {
     double area = 0.0;                        // inflow: columns * spacing^2
     double profile_mean = 1.0;                // inflow: mean of 1 - r^2 / R^2 over the columns
     int material = 0;                         // inflow: material of the fed body
+    std::vector<Vec3> columns;                // inflow: lattice points of the columns on the disc
     // Coordinates of x relative to the disc: along the normal, and distance from the axis.
     double axial(const Vec3& x) const { return (x - spec.point).dot(spec.normal); }
     double radial(const Vec3& x) const {
