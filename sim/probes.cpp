@@ -12,6 +12,12 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// Open-boundary buffer particles stand outside the domain: probes of bodies, energy and momentum leave them
+// out.
+bool is_buffer(Kind k) {
+  return k == Kind::Inflow || k == Kind::Outflow;
+}
+
 struct Sum3 {
   Vec3 a = Vec3::Zero(), b = Vec3::Zero();
   double m = 0.0;
@@ -95,7 +101,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const double best = parallel_reduce(
             n, -std::numeric_limits<double>::infinity(),
             [&](std::size_t i) {
-              if (!in_set[P.body[i]] || (pr.region && !pr.region->contains(P.x[i])))
+              if (!in_set[P.body[i]] || is_buffer(P.kind[i]) || (pr.region && !pr.region->contains(P.x[i])))
                 return -std::numeric_limits<double>::infinity();
               return sign * P.x[i][pr.axis];
             },
@@ -134,7 +140,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const Sum3 s = parallel_reduce(
             n, Sum3{},
             [&](std::size_t i) {
-              if (P.body[i] != pr.body) return Sum3{};
+              if (P.body[i] != pr.body || is_buffer(P.kind[i])) return Sum3{};
               return Sum3{P.m[i] * P.x[i], P.m[i] * P.v[i], P.m[i]};
             },
             [](const Sum3& a, const Sum3& b) { return a + b; });
@@ -168,7 +174,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const E e = parallel_reduce(
             n, E{},
             [&](std::size_t i) {
-              if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid) return E{};
+              if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid || is_buffer(P.kind[i])) return E{};
               return E{0.5 * P.m[i] * P.v[i].squaredNorm(), -P.m[i] * g.dot(P.x[i])};
             },
             [](const E& a, const E& b) {
@@ -188,7 +194,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const Sum3 t = parallel_reduce(
             n, Sum3{},
             [&](std::size_t i) {
-              if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid) return Sum3{};
+              if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid || is_buffer(P.kind[i])) return Sum3{};
               const Vec3 p = P.m[i] * P.v[i];
               return Sum3{p, P.x[i].cross(p), 0.0};
             },

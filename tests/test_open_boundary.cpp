@@ -417,6 +417,21 @@ TEST_CASE("open boundaries: scene keys load, defaults fill in", "[open][scene]")
                                                      "bal.mass_in", "bal.mass_out", "bal.mass_inside"});
   CHECK(w.count(Kind::Inflow) == 4 * 52);
   CHECK(w.count(Kind::Outflow) == 4 * 52);  // the fluid column runs through the outlet buffer
+  // Probes of a body leave its buffer particles out: the fluid's top is below the outlet disc (y = 16 mm).
+  Scene with_extent = s;
+  Probe top;
+  top.name = "top";
+  top.type = ProbeType::Extent;
+  top.bodies = {0};
+  top.axis = 1;
+  Probe bottom = top;
+  bottom.name = "bottom";
+  bottom.stat_max = false;
+  with_extent.probes = {top, bottom};
+  const World w2(with_extent);
+  const auto v = ProbeSet(with_extent, w2).measure(w2);
+  CHECK(v[0] == Approx(0.0155));
+  CHECK(v[1] == Approx(0.0005));
 }
 
 TEST_CASE("open boundaries: bad input is refused with the JSON path", "[open][scene][bad-input]") {
