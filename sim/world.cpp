@@ -133,7 +133,6 @@ World::World(const Scene& scene)
       }
       if (body.fixed && held == 0)
         throw SetupError(where + ".fixed: the region holds no particle of the body");
-      max_solid_c_ = std::max(max_solid_c_, SolidParams(mat).c);
     }
 
     // Fluid under gravity starts in hydrostatic balance: p = rho0 |g| depth below the body's top, and the
@@ -210,7 +209,7 @@ double World::stable_dt() const {
   if (max_c0_ > 0.0) dt = std::min(dt, scene_.cfl * h / (max_c0_ + max_speed_));
   // Elastic solids: the same condition with the P-wave speed sqrt((lambda + 2 mu) / rho), the fastest signal
   // of the solid.
-  if (max_solid_c_ > 0.0) dt = std::min(dt, scene_.cfl * h / (max_solid_c_ + max_speed_));
+  if (!solids_.empty()) dt = std::min(dt, scene_.cfl * h / (solids_.max_wave_speed() + max_speed_));
   // Viscous diffusion limit (Morris, Fox & Zhu 1997, eq. 18): dt <= 0.125 h^2 / nu.
   if (max_nu_ > 0.0) dt = std::min(dt, 0.125 * h * h / max_nu_);
   // Contact spring: two particles of mass m on a spring k touch for about pi sqrt(m / 2k) (m: see the
@@ -338,10 +337,8 @@ void World::integrate(double dt) {
   max_accel_ = std::max(std::sqrt(e.a2), gravity_.norm());
 }
 
-// Rigid bodies, eqs. (19)-(22): per particle the fluid's reaction (equal and opposite to what the fluid
-// feels) and contact forces (eqs. 23-25), summed per body in array order (the same order for any thread
-// count), plus gravity; then each body advances and its particles follow. The particles' acceleration, which
-// the wall boundary needs (Adami et al. 2012, eq. 27), is their change of velocity over the step.
+// Per body particle (rigid, elastic): the fluid's reaction (equal and opposite to what the fluid feels) and
+// contact forces (eqs. 23-25), with the contacts' moments for the rigid torque sums.
 void World::body_forces() {
   const std::size_t n = P_.size();
   force_.assign(n, Vec3::Zero());
@@ -372,6 +369,10 @@ void World::permute(const std::vector<uint32_t>& order) {
   solids_.reindex(P_);
 }
 
+// Rigid bodies, eqs. (19)-(22): the per-particle forces of body_forces() summed per body in array order (the
+// same order for any thread count), plus gravity; then each body advances and its particles follow. The
+// particles' acceleration, which the wall boundary needs (Adami et al. 2012, eq. 27), is their change of
+// velocity over the step.
 void World::step_rigid(double dt) {
   const std::size_t n = P_.size();
   for (RigidBody& b : rigid_) {

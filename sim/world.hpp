@@ -159,7 +159,6 @@ class World {
   double speed_limit_ = 0.0;
   double max_c0_ = 0.0;
   double max_nu_ = 0.0;
-  double max_solid_c_ = 0.0;  // largest P-wave speed of the elastic materials
   std::size_t moving_at_start_ = 0;
   std::size_t left_domain_ = 0;
   // Verlet lists: built with radius support + skin, rebuilt when a particle has moved skin / 2.
