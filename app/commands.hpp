@@ -17,13 +17,23 @@ struct RunOptions {
   bool no_render = false;
   bool vtk = false;
   bool quiet = false;
+  std::optional<double> checkpoint_every;  // --checkpoint-every T: simulated seconds between checkpoints
+};
+
+// aortasph resume DIR [--threads N] [--quiet]
+struct ResumeOptions {
+  std::filesystem::path dir;
+  int threads = 0;
+  bool quiet = false;
 };
 
 int cmd_run(const RunOptions& options);
+int cmd_resume(const ResumeOptions& options);
 int cmd_check(const std::filesystem::path& scene, const std::vector<std::string>& sets);
 int cmd_bench(int threads, bool quick, bool render, const std::filesystem::path& json_out);
 
 // Parses the arguments after the subcommand word (throws InputError on bad arguments).
 RunOptions parse_run_options(const std::vector<std::string>& args);
+ResumeOptions parse_resume_options(const std::vector<std::string>& args);
 
 }  // namespace aortasph

@@ -30,6 +30,21 @@ class PipelineSink : public FrameSink {
     }
     if (pipeline_.failed()) throw InputError("rendering failed: " + pipeline_.error());
   }
+  void flush() override {
+    try {
+      pipeline_.flush();
+    } catch (const std::exception& e) {
+      throw InputError(std::string("rendering failed: ") + e.what());
+    }
+  }
+  std::optional<std::pair<double, double>> field_range() const override { return pipeline_.field_range(); }
+  void adopt_existing_frames(int count) override {
+    try {
+      pipeline_.adopt_existing_frames(count);
+    } catch (const std::exception& e) {
+      throw InputError(std::string("resume: ") + e.what());
+    }
+  }
   void finish_quietly() override {
     try {
       pipeline_.finish();

@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <utility>
 
 #include "world.hpp"
 
@@ -18,6 +20,12 @@ class FrameSink {
   virtual void finish() = 0;
   // Same, after a failed run: writes what it can, never throws.
   virtual void finish_quietly() = 0;
+  // Waits until every pushed frame is on disk (before a checkpoint); throws on a render or write error.
+  virtual void flush() = 0;
+  // The colour range in use (recorded in checkpoints; empty for color_by material or before one is chosen).
+  virtual std::optional<std::pair<double, double>> field_range() const = 0;
+  // Resuming: frames 0 .. count-1 are on disk already (figures read back the ones they need).
+  virtual void adopt_existing_frames(int count) = 0;
 };
 
 // nullptr when the scene has no camera.

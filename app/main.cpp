@@ -18,14 +18,16 @@ const char* kUsage =
     "\n"
     "usage:\n"
     "  aortasph run SCENE.json [--out DIR] [--threads N] [--end-time T] [--set KEY=VALUE]...\n"
-    "                          [--no-render] [--vtk] [--quiet]\n"
+    "                          [--no-render] [--vtk] [--quiet] [--checkpoint-every T]\n"
+    "  aortasph resume DIR [--threads N] [--quiet]      continue an interrupted run from DIR/checkpoint.bin\n"
     "  aortasph check SCENE.json [--set KEY=VALUE]...   validate and print bodies, counts, h, dt, cost\n"
     "  aortasph compare A B [--diff DIFF.png] [--tolerance T]\n"
     "  aortasph movie DIR [--fps N]\n"
     "  aortasph bench [--threads N] [--quick] [--render] [--json FILE]\n"
     "  aortasph --help | --version\n"
     "\n"
-    "exit codes: 0 ok, 1 compare: images differ, 2 bad input, 3 unstable simulation, 130 interrupted\n";
+    "exit codes: 0 ok, 1 compare: images differ, 2 bad input, 3 unstable simulation, 130 interrupted\n"
+    "(SIGINT/SIGTERM: the step in hand is finished, a checkpoint written, every file flushed)\n";
 
 int dispatch(const std::vector<std::string>& args) {
   using namespace aortasph;
@@ -44,6 +46,7 @@ int dispatch(const std::vector<std::string>& args) {
     return 0;
   }
   if (cmd == "run") return cmd_run(parse_run_options(rest));
+  if (cmd == "resume") return cmd_resume(parse_resume_options(rest));
   if (cmd == "check") {
     std::string scene;
     std::vector<std::string> sets;

@@ -1,7 +1,9 @@
 #include "output.hpp"
 
 #include <cstdio>
+#include <cstdlib>
 #include <iomanip>
+#include <optional>
 
 #include "errors.hpp"
 
@@ -22,6 +24,43 @@ CsvWriter::CsvWriter(const std::filesystem::path& path, const std::vector<std::s
   out_.flush();
 }
 
+CsvWriter::CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns,
+                     std::size_t keep_rows)
+    : path_(path) {
+  std::string header = "time";
+  for (const auto& c : columns) header += "," + c;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": missing; cannot resume");
+  std::string kept, line;
+  std::size_t rows = 0;
+  if (!std::getline(in, line) || line != header)
+    throw InputError(path.string() + ": its columns differ from this scene's; cannot resume");
+  kept = header + "\n";
+  // Only whole lines count: a line without its newline was torn by a kill.
+  while (rows < keep_rows && std::getline(in, line) && !in.eof()) {
+    kept += line + "\n";
+    ++rows;
+  }
+  if (rows < keep_rows)
+    throw InputError(path.string() + ": has " + std::to_string(rows) +
+                     " complete rows, the checkpoint needs " + std::to_string(keep_rows) + "; cannot resume");
+  in.close();
+  // Rewritten through a temporary file, so a kill now leaves the old or the new file, never a shorter one.
+  std::filesystem::path tmp = path;
+  tmp += ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    f << kept;
+    f.close();
+    if (!f) throw InputError(tmp.string() + ": write failed (disk full?)");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw InputError(path.string() + ": cannot replace: " + ec.message());
+  out_.open(path, std::ios::binary | std::ios::app);
+  if (!out_) throw InputError(path.string() + ": cannot open for writing");
+}
+
 void CsvWriter::row(const std::vector<double>& values) {
   for (std::size_t k = 0; k < values.size(); ++k) out_ << (k ? "," : "") << format_number(values[k]);
   out_ << '\n';
@@ -33,6 +72,30 @@ VtkWriter::VtkWriter(const std::filesystem::path& dir) : dir_(dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir_, ec);
   if (ec) throw InputError(dir_.string() + ": cannot create folder: " + ec.message());
+}
+
+VtkWriter::VtkWriter(const std::filesystem::path& dir, int keep_frames) : VtkWriter(dir) {
+  std::ifstream in(dir_ / "particles.pvd");
+  std::string line;
+  auto attribute = [&](const std::string& key) -> std::optional<std::string> {
+    const auto at = line.find(key + "=\"");
+    if (at == std::string::npos) return std::nullopt;
+    const auto from = at + key.size() + 2, to = line.find('"', from);
+    if (to == std::string::npos) return std::nullopt;
+    return line.substr(from, to - from);
+  };
+  while (std::getline(in, line)) {
+    const auto t = attribute("timestep"), file = attribute("file");
+    if (!t || !file) continue;
+    int frame = -1;
+    if (std::sscanf(file->c_str(), "particles_%d.vtp", &frame) != 1 || frame < 0 || frame >= keep_frames)
+      continue;
+    files_.emplace_back(std::strtod(t->c_str(), nullptr), *file);
+  }
+  if (static_cast<int>(files_.size()) != keep_frames)
+    throw InputError((dir_ / "particles.pvd").string() + ": lists " + std::to_string(files_.size()) +
+                     " of the " + std::to_string(keep_frames) +
+                     " frames written before the checkpoint; cannot resume");
 }
 
 VtkWriter::~VtkWriter() = default;

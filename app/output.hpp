@@ -16,6 +16,11 @@ namespace aortasph {
 class CsvWriter {
  public:
   CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns);
+  // Resuming: keeps the header (which must match columns) and the first keep_rows rows of the existing file,
+  // drops everything after them (rows written after the checkpoint, a torn last line) and appends from there.
+  // Throws InputError when the file is missing, has other columns or fewer rows.
+  CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns,
+            std::size_t keep_rows);
   void row(const std::vector<double>& values);
 
  private:
@@ -27,6 +32,8 @@ class CsvWriter {
 class VtkWriter {
  public:
   explicit VtkWriter(const std::filesystem::path& dir);
+  // Resuming: keeps the entries of frames 0 .. keep_frames-1 from the existing particles.pvd.
+  VtkWriter(const std::filesystem::path& dir, int keep_frames);
   void write(const World& world, int frame);
   ~VtkWriter();
 

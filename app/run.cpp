@@ -13,12 +13,14 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "checkpoint.hpp"
 #include "commands.hpp"
 #include "errors.hpp"
 #include "frames.hpp"
 #include "output.hpp"
 #include "parallel.hpp"
 #include "probes.hpp"
+#include "resources.hpp"
 #include "scene_loader.hpp"
 #include "sim_errors.hpp"
 #include "world.hpp"
@@ -27,8 +29,9 @@ namespace aortasph {
 
 namespace {
 
+// Set by SIGINT and SIGTERM; the run loop finishes the step in hand, writes a checkpoint and exits 130.
 std::atomic<bool> g_interrupted{false};
-extern "C" void on_sigint(int) {
+extern "C" void on_signal(int) {
   g_interrupted = true;
 }
 
@@ -158,7 +161,10 @@ RunOptions parse_run_options(const std::vector<std::string>& args) {
       o.vtk = true;
     else if (a == "--quiet")
       o.quiet = true;
-    else if (!a.empty() && a[0] == '-')
+    else if (a == "--checkpoint-every") {
+      o.checkpoint_every = parse_double(a, value());
+      if (*o.checkpoint_every <= 0) throw InputError("--checkpoint-every: must be positive, got " + args[k]);
+    } else if (!a.empty() && a[0] == '-')
       throw InputError(a + ": unknown option (see aortasph --help)");
     else if (!have_scene) {
       o.scene = a;
@@ -170,44 +176,166 @@ RunOptions parse_run_options(const std::vector<std::string>& args) {
   return o;
 }
 
-int cmd_run(const RunOptions& o) {
-  LoadedScene loaded = load_scene(o.scene, o.sets);
-  Scene& scene = loaded.scene;
-  if (o.end_time) {
-    scene.t_end = *o.end_time;
-    loaded.resolved["time"]["end"] = *o.end_time;
+namespace {
+
+constexpr const char* kCheckpointFile = "checkpoint.bin";
+
+uint64_t scene_hash(const nlohmann::json& resolved) {
+  const std::string text = resolved.dump();
+  return fnv1a64(text.data(), text.size());
+}
+
+// What a checkpoint records besides the World: the program version, the resolved scene and the run's
+// options, how many outputs are on disk, and the renderer's colour range.
+struct RunRecord {
+  std::string version = AORTASPH_VERSION;
+  std::string scene;  // resolved scene JSON
+  uint64_t hash = 0;
+  std::string scene_file;
+  std::vector<std::string> sets;
+  bool no_render = false, vtk = false;
+  double checkpoint_every = 0.0, next_checkpoint = 0.0;
+  // --end-time: the end the run uses and the scene file's own (figures are validated against the latter).
+  double end_override = 0.0, file_end = 0.0;
+  int32_t frames = 0;
+  std::optional<std::pair<double, double>> range;
+
+  void save(StateWriter& out) const {
+    SectionWriter& w = out.section("run", 1);
+    w.string(version);
+    w.string(scene);
+    w.value(hash);
+    w.string(scene_file);
+    w.value(static_cast<uint64_t>(sets.size()));
+    for (const auto& set : sets) w.string(set);
+    w.value(no_render);
+    w.value(vtk);
+    w.value(checkpoint_every);
+    w.value(next_checkpoint);
+    w.value(end_override);
+    w.value(file_end);
+    w.value(frames);
+    w.value(range.has_value());
+    w.value(range ? range->first : 0.0);
+    w.value(range ? range->second : 0.0);
   }
-  const std::filesystem::path dir = o.out ? *o.out : std::filesystem::path("out") / scene.name;
+  // The version is read and checked first: a checkpoint of another version is refused before anything of
+  // its layout is trusted.
+  static RunRecord load(const StateReader& in, const std::filesystem::path& file) {
+    SectionReader r = in.section("run");
+    RunRecord rec;
+    rec.version = r.string();
+    if (rec.version != AORTASPH_VERSION)
+      throw InputError(file.string() + ": written by aortasph " + rec.version + ", this is aortasph " +
+                       AORTASPH_VERSION + "; a checkpoint resumes only with the version that wrote it");
+    rec.scene = r.string();
+    rec.hash = r.value<uint64_t>();
+    rec.scene_file = r.string();
+    const auto n = r.value<uint64_t>();
+    for (uint64_t k = 0; k < n; ++k) rec.sets.push_back(r.string());
+    rec.no_render = r.value<bool>();
+    rec.vtk = r.value<bool>();
+    rec.checkpoint_every = r.value<double>();
+    rec.next_checkpoint = r.value<double>();
+    rec.end_override = r.value<double>();
+    rec.file_end = r.value<double>();
+    rec.frames = r.value<int32_t>();
+    const bool has_range = r.value<bool>();
+    const double lo = r.value<double>(), hi = r.value<double>();
+    if (has_range) rec.range = std::pair{lo, hi};
+    r.done();
+    if (fnv1a64(rec.scene.data(), rec.scene.size()) != rec.hash)
+      throw InputError(file.string() + ": the recorded scene does not match its hash (damaged checkpoint)");
+    if (rec.frames < 1) throw InputError(file.string() + ": records no output (damaged checkpoint)");
+    return rec;
+  }
+};
+
+// The run itself, fresh or resumed (resume: the checkpoint and its record; the World is built from the scene
+// and then given the checkpoint's state, so it continues exactly where the interrupted run stopped).
+int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path& dir, double file_end,
+            const StateReader* resume, const RunRecord* record) {
+  Scene& scene = loaded.scene;
   prepare_out_dir(dir);
   if (o.threads > 0) set_threads(o.threads);
   const int threads = max_threads();
+  const long outputs = static_cast<long>(std::floor(scene.t_end / scene.output_interval + 1e-9));
+  const int first_frame = record ? record->frames : 0;
+  const bool render = !o.no_render && !scene.render.cameras.empty();
+  check_resources(scene, dir, outputs + 1 - first_frame + (scene.t_end > outputs * scene.output_interval),
+                  render, o.vtk);
+
+  if (!resume) {
+    // A checkpoint left by an earlier run in this folder would no longer match the files this run writes.
+    std::error_code ec;
+    std::filesystem::remove(dir / kCheckpointFile, ec);
+  }
 
   const auto wall_start = Clock::now();
   World world(scene);
-  ProbeSet probes(scene, world);
-  CsvWriter probe_csv(dir / "probes.csv", probes.columns());
-  CsvWriter diag_csv(dir / "diagnostics.csv", diagnostics_columns());
+  ProbeSet probes(scene, world);  // resolved on the state at t = 0, as in the run that wrote the checkpoint
+  if (resume) world.load_state(*resume);
+  std::optional<CsvWriter> probe_csv, diag_csv;
   std::optional<VtkWriter> vtk;
-  if (o.vtk) vtk.emplace(dir / "vtk");
+  if (resume) {
+    probe_csv.emplace(dir / "probes.csv", probes.columns(), first_frame);
+    diag_csv.emplace(dir / "diagnostics.csv", diagnostics_columns(), first_frame);
+    if (o.vtk) vtk.emplace(dir / "vtk", first_frame);
+  } else {
+    probe_csv.emplace(dir / "probes.csv", probes.columns());
+    diag_csv.emplace(dir / "diagnostics.csv", diagnostics_columns());
+    if (o.vtk) vtk.emplace(dir / "vtk");
+  }
   std::unique_ptr<FrameSink> frames;
-  if (!o.no_render) frames = make_frame_sink(scene, dir);
+  if (!o.no_render) {
+    // The colour range of the interrupted run, so the resumed frames are coloured alike.
+    Scene render_scene = scene;
+    if (record && record->range) render_scene.render.range = record->range;
+    frames = make_frame_sink(render_scene, dir);
+    if (frames && resume) frames->adopt_existing_frames(first_frame);
+  }
   const double setup_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
 
   if (!o.quiet)
-    std::fprintf(stderr, "aortasph: %s: %zu particles (%zu fluid), h = %g m, %d thread(s) -> %s\n",
+    std::fprintf(stderr, "aortasph: %s: %zu particles (%zu fluid), h = %g m, %d thread(s) -> %s%s\n",
                  scene.name.c_str(), world.particles().size(), world.count(Kind::Fluid), world.kernel().h,
-                 threads, dir.string().c_str());
+                 threads, dir.string().c_str(),
+                 resume ? (" (resumed at t = " + format_number(world.time()) + " s)").c_str() : "");
 
-  int frame = 0;
+  int frame = first_frame;
   auto output = [&]() {
     std::vector<double> row{world.time()};
     const auto values = probes.measure(world);
     row.insert(row.end(), values.begin(), values.end());
-    probe_csv.row(row);
-    diag_csv.row(diagnostics_row(world));
+    probe_csv->row(row);
+    diag_csv->row(diagnostics_row(world));
     if (vtk) vtk->write(world, frame);
     if (frames) frames->push(world, frame);
     ++frame;
+  };
+
+  RunRecord rec;
+  rec.scene = loaded.resolved.dump();
+  rec.hash = scene_hash(loaded.resolved);
+  rec.scene_file = o.scene.string();
+  rec.sets = o.sets;
+  rec.no_render = o.no_render;
+  rec.vtk = o.vtk;
+  rec.checkpoint_every = o.checkpoint_every.value_or(0.0);
+  rec.next_checkpoint = record ? record->next_checkpoint : rec.checkpoint_every;
+  rec.end_override = o.end_time.value_or(0.0);
+  rec.file_end = file_end;
+
+  // A checkpoint counts only what is on disk: the frames pushed so far are written first (the CSV rows are
+  // flushed row by row). Written atomically, so a kill at any moment leaves the previous or this one.
+  auto write_checkpoint = [&]() {
+    if (frames) frames->flush();
+    rec.frames = frame;
+    rec.range = frames ? frames->field_range() : std::nullopt;
+    StateWriter out;
+    rec.save(out);
+    world.save_state(out);
+    out.write_file(dir / kCheckpointFile);
   };
 
   auto write_run_json = [&](const std::string& status, const std::string& message) {
@@ -220,6 +348,8 @@ int cmd_run(const RunOptions& o) {
     j["scene"] = loaded.resolved;
     j["scene_file"] = o.scene.string();
     j["sets"] = o.sets;
+    if (o.checkpoint_every) j["checkpoint_every"] = *o.checkpoint_every;
+    if (resume) j["resumed_at"] = {{"time", world.time()}, {"frame", first_frame}};
     j["particles"] = {{"total", world.particles().size()},
                       {"fluid", world.count(Kind::Fluid)},
                       {"boundary", world.particles().size() - world.count(Kind::Fluid)}};
@@ -229,17 +359,29 @@ int cmd_run(const RunOptions& o) {
     for (const auto& [name, sec] : world.profile().phases()) j["timings_s"][name] = sec;
     std::ofstream f(dir / "run.json", std::ios::trunc);
     f << std::setw(2) << j << '\n';
+    f.close();
+    if (!f) throw InputError((dir / "run.json").string() + ": write failed (disk full?)");
   };
 
   g_interrupted = false;
-  auto previous = std::signal(SIGINT, on_sigint);
+  auto previous_int = std::signal(SIGINT, on_signal);
+  auto previous_term = std::signal(SIGTERM, on_signal);
+  struct RestoreSignals {
+    decltype(previous_int) i, t;
+    ~RestoreSignals() {
+      std::signal(SIGINT, i);
+      std::signal(SIGTERM, t);
+    }
+  } restore{previous_int, previous_term};
+
   Progress progress(scene.t_end, o.quiet);
   int code = 0;
   try {
-    output();
+    write_run_json("running", "");
+    if (!resume) output();
     // Outputs at exactly k * output_interval (SPEC section 2), then at t_end if that is not one of them.
-    const long outputs = static_cast<long>(std::floor(scene.t_end / scene.output_interval + 1e-9));
-    for (long k = 1; k <= outputs + 1 && !g_interrupted; ++k) {
+    // Output k is frame k, so a resumed run continues at k = the frames already written.
+    for (long k = std::max(1, first_frame); k <= outputs + 1 && !g_interrupted; ++k) {
       const double target = k <= outputs ? static_cast<double>(k) * scene.output_interval : scene.t_end;
       if (target <= world.time()) break;
       const bool reached = world.advance_to(target, [&] {
@@ -248,12 +390,21 @@ int cmd_run(const RunOptions& o) {
       });
       if (!reached) break;  // interrupted between outputs: no partial row, everything before stays valid
       output();
+      if (rec.checkpoint_every > 0.0 && world.time() >= rec.next_checkpoint && !g_interrupted) {
+        while (rec.next_checkpoint <= world.time()) rec.next_checkpoint += rec.checkpoint_every;
+        write_checkpoint();
+      }
     }
     progress.done();
     if (frames) frames->finish();
     if (g_interrupted) {
-      std::fprintf(stderr, "aortasph: interrupted at t = %g s; everything written so far is valid\n",
-                   world.time());
+      // SIGINT / SIGTERM: the step in hand is finished, the frames in the queue are written, then the state.
+      write_checkpoint();
+      std::fprintf(
+          stderr,
+          "aortasph: interrupted at t = %g s; checkpoint written, everything written so far is valid "
+          "(continue with: aortasph resume %s)\n",
+          world.time(), dir.string().c_str());
       write_run_json("interrupted", "");
       code = 130;
     } else {
@@ -263,10 +414,18 @@ int cmd_run(const RunOptions& o) {
     progress.done();
     if (frames) frames->finish_quietly();
     write_run_json("unstable", e.what());
-    std::signal(SIGINT, previous);
+    throw;
+  } catch (const std::exception& e) {
+    // A write error (disk full) or a render failure: stop with every file as complete as it can be.
+    progress.done();
+    if (frames) frames->finish_quietly();
+    try {
+      write_run_json("failed", e.what());
+    } catch (const std::exception&) {
+      // The run's own error is the one to report.
+    }
     throw;
   }
-  std::signal(SIGINT, previous);
   if (!o.quiet && code == 0) {
     const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
     std::fprintf(stderr, "aortasph: done: %ld steps, %d outputs, %.1f s wall (%.3g particle-steps/s) -> %s\n",
@@ -276,6 +435,96 @@ int cmd_run(const RunOptions& o) {
                  dir.string().c_str());
   }
   return code;
+}
+
+}  // namespace
+
+int cmd_run(const RunOptions& o) {
+  LoadedScene loaded = load_scene(o.scene, o.sets);
+  const double file_end = loaded.scene.t_end;
+  if (o.end_time) {
+    loaded.scene.t_end = *o.end_time;
+    loaded.resolved["time"]["end"] = *o.end_time;
+  }
+  const std::filesystem::path dir = o.out ? *o.out : std::filesystem::path("out") / loaded.scene.name;
+  return execute(std::move(loaded), o, dir, file_end, nullptr, nullptr);
+}
+
+ResumeOptions parse_resume_options(const std::vector<std::string>& args) {
+  ResumeOptions o;
+  bool have_dir = false;
+  for (std::size_t k = 0; k < args.size(); ++k) {
+    const std::string& a = args[k];
+    if (a == "--threads") {
+      if (k + 1 >= args.size()) throw InputError(a + ": missing value");
+      o.threads = parse_int(a, args[++k]);
+      if (o.threads < 1 || o.threads > 1024) throw InputError("--threads: expected 1..1024, got " + args[k]);
+    } else if (a == "--quiet") {
+      o.quiet = true;
+    } else if (!a.empty() && a[0] == '-') {
+      throw InputError(a + ": unknown option for resume (see aortasph --help)");
+    } else if (!have_dir) {
+      o.dir = a;
+      have_dir = true;
+    } else {
+      throw InputError(a + ": unexpected argument (one output folder)");
+    }
+  }
+  if (!have_dir) throw InputError("resume: missing the output folder (aortasph resume DIR)");
+  return o;
+}
+
+int cmd_resume(const ResumeOptions& ro) {
+  const std::filesystem::path file = ro.dir / kCheckpointFile;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw InputError(file.string() +
+                     ": no checkpoint to resume from (run with --checkpoint-every T, or stop " +
+                     "a run with Ctrl-C / SIGTERM)");
+  StateReader state = [&] {
+    try {
+      return StateReader::from_file(file);
+    } catch (const SetupError& e) {
+      throw InputError(e.what());
+    }
+  }();
+  const RunRecord record = RunRecord::load(state, file);
+  nlohmann::json resolved = nlohmann::json::parse(record.scene, nullptr, false);
+  if (resolved.is_discarded()) throw InputError(file.string() + ": the recorded scene is not valid JSON");
+  // run.json names the scene this folder's files belong to: a checkpoint of another scene is refused.
+  std::ifstream run_json(ro.dir / "run.json");
+  if (run_json) {
+    const nlohmann::json j = nlohmann::json::parse(run_json, nullptr, false);
+    if (j.is_discarded() || !j.contains("scene") || scene_hash(j["scene"]) != record.hash)
+      throw InputError((ro.dir / "run.json").string() + " describes another scene than " + file.string() +
+                       " (scene hash mismatch); refusing to mix two runs in one folder");
+  }
+  // Loaded as the file was (figure times are checked against the file's time.end), then --end-time again.
+  nlohmann::json as_file = resolved;
+  if (record.end_override > 0.0) as_file["time"]["end"] = record.file_end;
+  LoadedScene loaded = load_scene_json(as_file, {});
+  if (record.end_override > 0.0) {
+    loaded.scene.t_end = record.end_override;
+    loaded.resolved["time"]["end"] = record.end_override;
+  }
+  if (scene_hash(loaded.resolved) != record.hash)
+    throw InputError(file.string() + ": the recorded scene no longer resolves to the same values with this " +
+                     "program; cannot resume");
+  RunOptions o;
+  o.scene = record.scene_file;
+  o.out = ro.dir;
+  o.threads = ro.threads;
+  o.sets = record.sets;
+  o.no_render = record.no_render;
+  o.vtk = record.vtk;
+  o.quiet = ro.quiet;
+  if (record.checkpoint_every > 0.0) o.checkpoint_every = record.checkpoint_every;
+  if (record.end_override > 0.0) o.end_time = record.end_override;
+  try {
+    return execute(std::move(loaded), o, ro.dir, record.file_end, &state, &record);
+  } catch (const SetupError& e) {
+    throw InputError(std::string("resume: ") + e.what());
+  }
 }
 
 int cmd_check(const std::filesystem::path& file, const std::vector<std::string>& sets) {

@@ -193,7 +193,8 @@ class Loader {
     if (s.smoothing_ratio < 1.0 || s.smoothing_ratio > 3.0)
       fail(res.path("smoothing_ratio"), "must lie in 1..3");
 
-    Obj time(top.raw("time"), "time", {"end", "output_interval", "cfl", "max_dt", "max_speed", "fixed_dt"},
+    Obj time(top.raw("time"), "time",
+             {"end", "output_interval", "cfl", "max_dt", "max_speed", "max_density_error", "fixed_dt"},
              allowed);
     s.t_end = time.positive("end");
     s.output_interval = time.positive("output_interval");
@@ -201,6 +202,7 @@ class Loader {
     if (s.cfl > 1) fail(time.path("cfl"), "must lie in (0, 1]");
     s.max_dt = time.positive("max_dt", 1e-3);
     s.max_speed = time.non_negative("max_speed", 0.0);
+    s.max_density_error = time.non_negative("max_density_error", 0.5);
     s.fixed_dt = time.non_negative("fixed_dt", 0.0);
     if (s.t_end / s.output_interval > 1e6) fail(time.path("output_interval"), "more than a million outputs");
 
@@ -612,18 +614,27 @@ LoadedScene load_scene_json(const nlohmann::json& j, const std::vector<std::stri
   return {Loader{}.load(filled), filled};
 }
 
+LoadedScene load_scene_text(const std::string& text, const std::vector<std::string>& overrides,
+                            const std::string& what) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::exception& e) {
+    // parse_error, and out_of_range for a number beyond the double range (1e999).
+    throw InputError(what + ": not valid JSON: " + e.what());
+  }
+  return load_scene_json(j, overrides);
+}
+
 LoadedScene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file.string() + ": no such scene file");
-  std::ifstream f(file);
+  std::ifstream f(file, std::ios::binary);
   if (!f) throw InputError(file.string() + ": cannot read");
-  json j;
-  try {
-    j = json::parse(f);
-  } catch (const json::parse_error& e) {
-    throw InputError(file.string() + ": not valid JSON: " + e.what());
-  }
-  return load_scene_json(j, overrides, file.parent_path());
+  std::ostringstream text;
+  text << f.rdbuf();
+  if (f.bad()) throw InputError(file.string() + ": cannot read");
+  return load_scene_text(text.str(), overrides, file.string());
 }
 
 }  // namespace aortasph

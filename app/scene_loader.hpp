@@ -20,6 +20,9 @@ struct LoadedScene {
 
 // overrides: "KEY=VALUE" strings from --set (dotted path with list indices; VALUE is JSON, or else a string).
 LoadedScene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides);
+// The text of a scene file (what load_scene reads); `what` names it in messages.
+LoadedScene load_scene_text(const std::string& text, const std::vector<std::string>& overrides,
+                            const std::string& what = "scene");
 LoadedScene load_scene_json(const nlohmann::json& j, const std::vector<std::string>& overrides,
                             const std::filesystem::path& base_dir = {});
 

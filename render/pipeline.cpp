@@ -12,6 +12,21 @@ namespace aortasph {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// A frame reduced to figure-panel size (at most kMaxPanelWidth wide, even height).
+Image panel_of(const Image& image) {
+  int w = image.w, h = image.h;
+  if (w > FramePipeline::kMaxPanelWidth) {
+    h = std::max(
+        2, static_cast<int>(std::lround(static_cast<double>(h) * FramePipeline::kMaxPanelWidth / w)) & ~1);
+    w = FramePipeline::kMaxPanelWidth;
+  }
+  return resize(image, w, h);
+}
+
+}  // namespace
+
 FramePipeline::FramePipeline(const RenderSettings& settings, fs::path out_dir, double output_interval,
                              std::size_t capacity)
     : settings_(settings),
@@ -118,10 +133,35 @@ void FramePipeline::thread_main(std::promise<void>* ready) {
       // Popped only after the frame is written, so the queue bound also counts the frame in hand.
       std::lock_guard lock(mutex_);
       if (!queue_.empty()) queue_.pop_front();
+      range_ = renderer->field_range();
     }
     changed_.notify_all();
   }
+  std::lock_guard lock(mutex_);
   range_ = renderer->field_range();
+}
+
+void FramePipeline::flush() {
+  std::unique_lock lock(mutex_);
+  changed_.wait(lock, [&] { return failed_ || queue_.empty(); });
+  if (failed_) throw RenderError(error_);
+}
+
+std::optional<std::pair<double, double>> FramePipeline::field_range() const {
+  std::lock_guard lock(mutex_);
+  return range_;
+}
+
+void FramePipeline::adopt_existing_frames(int count) {
+  std::lock_guard lock(mutex_);
+  for (const auto& [camera, frames] : wanted_)
+    for (int frame : frames) {
+      if (frame >= count || panels_.count({camera, frame})) continue;
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%05d.png", frame);
+      panels_[{camera, frame}] = {frame * output_interval_,
+                                  panel_of(read_png(out_dir_ / "frames" / camera / name))};
+    }
 }
 
 void FramePipeline::render_one(Renderer& renderer, const Snapshot& snapshot) {
@@ -136,12 +176,7 @@ void FramePipeline::render_one(Renderer& renderer, const Snapshot& snapshot) {
     write_png(out_dir_ / "frames" / camera.name / name, image);
     const auto it = wanted_.find(camera.name);
     if (it != wanted_.end() && std::count(it->second.begin(), it->second.end(), snapshot.frame)) {
-      int w = image.w, h = image.h;
-      if (w > kMaxPanelWidth) {
-        h = std::max(2, static_cast<int>(std::lround(static_cast<double>(h) * kMaxPanelWidth / w)) & ~1);
-        w = kMaxPanelWidth;
-      }
-      panels_[{camera.name, snapshot.frame}] = {snapshot.time, resize(image, w, h)};
+      panels_[{camera.name, snapshot.frame}] = {snapshot.time, panel_of(image)};
     }
   }
 }

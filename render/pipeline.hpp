@@ -50,6 +50,16 @@ class FramePipeline {
   // render or write error happened. Calling it twice is harmless.
   void finish();
 
+  // Waits until every queued snapshot is rendered and written (a checkpoint counts only the frames on disk).
+  // Throws RenderError if the render thread has failed.
+  void flush();
+  // The colour range chosen so far (settings.range or the one picked from the first non-constant field);
+  // a resumed run passes it back in settings.range so its frames keep the same colours.
+  std::optional<std::pair<double, double>> field_range() const;
+  // Resuming: frames 0 .. count-1 are already on disk; the ones that figures need are read back from
+  // out_dir/frames/<camera>/. Call before the first push(). Throws RenderError when such a frame is missing.
+  void adopt_existing_frames(int count);
+
   bool failed() const;
   std::string error() const;
   // Largest panel width kept for figures; larger frames are scaled down (area average).
@@ -79,7 +89,7 @@ class FramePipeline {
   std::map<std::pair<std::string, int>, std::pair<double, Image>>
       panels_;                                      // (camera, frame) -> (time, image)
   std::map<std::string, std::vector<int>> wanted_;  // camera -> frames for figures
-  std::optional<std::pair<double, double>> range_;
+  std::optional<std::pair<double, double>> range_;  // guarded by mutex_ while the thread runs
   std::string field_name_, field_unit_;
 };
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "scene.hpp"
@@ -31,38 +32,46 @@ struct Particles {
 
   std::size_t size() const { return x.size(); }
 
+  // Calls f(name, array) for every per-particle array: the one list that resize(), permute() and the
+  // checkpoint (World::save_state) follow, so a new array added here is sorted, removed and saved with the
+  // rest.
+  template <class F>
+  void for_each_array(F&& f) {
+    f("x", x);
+    f("v", v);
+    f("a", a);
+    f("rho", rho);
+    f("drho", drho);
+    f("p", p);
+    f("v_wall", v_wall);
+    f("m", m);
+    f("x0", x0);
+    f("kind", kind);
+    f("body", body);
+    f("material", material);
+    f("id", id);
+  }
+  template <class F>
+  void for_each_array(F&& f) const {
+    const_cast<Particles*>(this)->for_each_array(
+        [&](const char* name, const auto& array) { f(name, array); });
+  }
+
   void resize(std::size_t n) {
-    x.resize(n, Vec3::Zero());
-    v.resize(n, Vec3::Zero());
-    a.resize(n, Vec3::Zero());
-    rho.resize(n, 0.0);
-    drho.resize(n, 0.0);
-    p.resize(n, 0.0);
-    v_wall.resize(n, Vec3::Zero());
-    m.resize(n, 0.0);
-    x0.resize(n, Vec3::Zero());
-    kind.resize(n, Kind::Fluid);
-    body.resize(n, 0);
-    material.resize(n, 0);
-    id.resize(n, 0);
+    // New entries are zero (Kind::Fluid for kind).
+    for_each_array([n](const char*, auto& array) {
+      using T = typename std::decay_t<decltype(array)>::value_type;
+      if constexpr (std::is_same_v<T, Vec3>)
+        array.resize(n, Vec3::Zero());
+      else
+        array.resize(n, T{});
+    });
   }
 
   // New order: particle k of the result is particle order[k] of the current arrays. order may be shorter
   // than size() (particles left out are removed).
   void permute(const std::vector<uint32_t>& order) {
-    apply(x, order);
-    apply(v, order);
-    apply(a, order);
-    apply(rho, order);
-    apply(drho, order);
-    apply(p, order);
-    apply(v_wall, order);
-    apply(m, order);
-    apply(x0, order);
-    apply(kind, order);
-    apply(body, order);
-    apply(material, order);
-    apply(id, order);
+    for_each_array([&order](const char*, auto& array) { apply(array, order); });
   }
 
  private:

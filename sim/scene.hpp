@@ -141,8 +141,9 @@ struct Scene {
   double output_interval = 0.01;
   double cfl = 0.25;
   double max_dt = 1e-3;
-  double max_speed = 0.0;  // instability limit [m/s]; 0 = derived from the sound speed
-  double fixed_dt = 0.0;   // > 0: every step has this length, stable or not (for debugging and tests)
+  double max_speed = 0.0;          // instability limit [m/s]; 0 = derived from the sound speed
+  double max_density_error = 0.5;  // instability limit on max |rho / rho0 - 1| of fluid particles; 0 = off
+  double fixed_dt = 0.0;           // > 0: every step has this length, stable or not (for debugging and tests)
   Vec3 gravity = Vec3(0, -9.81, 0);
   std::vector<Material> materials;
   Contact contact;

@@ -419,6 +419,29 @@ void World::check_and_remove(double dt) {
     throw InstabilityError(msg.str());
   }
 
+  // Density error: a weakly compressible fluid stays within a few per cent of its rest density; far beyond
+  // that the pressure has blown up (time step too large, sound speed too low for the flow).
+  if (scene_.max_density_error > 0.0) {
+    const double limit = scene_.max_density_error;
+    const std::size_t over = parallel_reduce(
+        n, n,
+        [&](std::size_t i) {
+          // Density summation (eq. 11) makes free-surface particles under-dense by design: not checked.
+          if (P_.kind[i] != Kind::Fluid || fluid_[P_.material[i]].summation) return n;
+          return std::abs(P_.rho[i] / fluid_[P_.material[i]].rho0 - 1.0) > limit ? i : n;
+        },
+        [](std::size_t a, std::size_t b) { return std::min(a, b); });
+    if (over < n) {
+      std::ostringstream msg;
+      msg << "unstable at t = " << time_ + dt << " s, step " << steps_ + 1 << " (dt = " << dt
+          << " s): particle " << P_.id[over] << " of body '" << scene_.bodies[P_.body[over]].name << "' at "
+          << fmt_vec(P_.x[over]) << " has density " << P_.rho[over] << " kg/m^3, a density error of "
+          << std::abs(P_.rho[over] / fluid_[P_.material[over]].rho0 - 1.0) << ", over the limit of " << limit
+          << " (time.max_density_error)";
+      throw InstabilityError(msg.str());
+    }
+  }
+
   // Particles that leave the domain are removed; more than the allowed fraction is an instability.
   const Box& dom = scene_.domain;
   const std::size_t outside = parallel_reduce(
@@ -463,6 +486,110 @@ std::size_t World::memory_bytes() const {
   const std::size_t per =
       sizeof(Vec3) * 5 + sizeof(double) * 4 + sizeof(Kind) + 2 * sizeof(uint16_t) + sizeof(uint32_t);
   return per * P_.x.capacity() + nb_.bytes();
+}
+
+// Checkpoint sections. Each reader checks sizes against this World (built from the same scene), so a
+// checkpoint of another scene is refused rather than misread.
+void World::save_state(StateWriter& out) const {
+  SectionWriter& w = out.section("world", 1);
+  w.value(time_);
+  w.value(steps_);
+  w.value(last_dt_);
+  w.value(max_speed_);
+  w.value(max_accel_);
+  w.value(static_cast<uint64_t>(left_domain_));
+  w.value(static_cast<uint64_t>(moving_at_start_));
+  for (const auto& [name, sec] : profile_.phases()) w.value(sec);
+
+  SectionWriter& p = out.section("particles", 1);
+  p.value(static_cast<uint64_t>(P_.size()));
+  P_.for_each_array([&](const char* name, const auto& array) {
+    p.string(name);
+    p.array(array);
+  });
+
+  SectionWriter& r = out.section("rigid", 1);
+  r.value(static_cast<uint64_t>(rigid_.size()));
+  for (const RigidBody& b : rigid_) {
+    r.value(b.body);
+    r.vec3(b.com);
+    r.value(b.q.w());
+    r.vec3(b.q.vec());
+    r.vec3(b.P);
+    r.vec3(b.L);
+  }
+
+  // The Verlet lists are rebuilt from the positions of their last build (and the rebuild and sort schedule
+  // continues from builds_), so the resumed run sees the very lists the saved one had.
+  SectionWriter& nb = out.section("neighbors", 1);
+  nb.value(lists_valid_);
+  nb.value(builds_);
+  nb.array(x_at_build_);
+}
+
+void World::load_state(const StateReader& in) {
+  SectionReader w = in.section("world");
+  time_ = w.value<double>();
+  steps_ = w.value<long>();
+  last_dt_ = w.value<double>();
+  max_speed_ = w.value<double>();
+  max_accel_ = w.value<double>();
+  left_domain_ = static_cast<std::size_t>(w.value<uint64_t>());
+  const auto moving = w.value<uint64_t>();
+  if (moving != moving_at_start_) w.mismatch("moving particles at t = 0", moving, moving_at_start_);
+  double* phases[] = {&profile_.neighbors, &profile_.density, &profile_.boundary,  &profile_.forces,
+                      &profile_.solid,     &profile_.rigid,   &profile_.integrate, &profile_.sort};
+  for (double* sec : phases) *sec = w.value<double>();
+  w.done();
+
+  SectionReader p = in.section("particles");
+  const auto n = static_cast<std::size_t>(p.value<uint64_t>());
+  if (n > P_.size()) p.mismatch("particles", n, P_.size());  // particles are removed, never added (yet)
+  P_.for_each_array([&](const char* name, auto& array) {
+    const std::string stored = p.string();
+    if (stored != name)
+      throw SetupError("checkpoint section 'particles': array '" + stored + "' where '" + name +
+                       "' was expected (another layout)");
+    array.clear();
+    p.array(array, name, n);
+  });
+  p.done();
+  for (std::size_t i = 0; i < n; ++i)
+    if (P_.body[i] >= bodies_.size() || P_.material[i] >= scene_.materials.size() ||
+        static_cast<uint8_t>(P_.kind[i]) > static_cast<uint8_t>(Kind::Elastic))
+      throw SetupError("checkpoint section 'particles': particle " + std::to_string(i) +
+                       " refers to a body or material this scene does not have");
+
+  SectionReader r = in.section("rigid");
+  const auto nr = r.value<uint64_t>();
+  if (nr != rigid_.size()) r.mismatch("rigid bodies", nr, rigid_.size());
+  for (RigidBody& b : rigid_) {
+    if (r.value<int>() != b.body) throw SetupError("checkpoint section 'rigid': bodies in another order");
+    b.com = r.vec3();
+    const double qw = r.value<double>();
+    const Vec3 qv = r.vec3();
+    b.q = Eigen::Quaterniond(qw, qv.x(), qv.y(), qv.z());
+    b.P = r.vec3();
+    b.L = r.vec3();
+  }
+  r.done();
+
+  SectionReader nb = in.section("neighbors");
+  lists_valid_ = nb.value<bool>();
+  builds_ = nb.value<long>();
+  nb.array(x_at_build_, "x_at_build");
+  nb.done();
+  if (lists_valid_) {
+    if (x_at_build_.size() != n) nb.mismatch("x_at_build", x_at_build_.size(), n);
+    nb_.build(x_at_build_, kernel_.support + skin_, fixed_mask());
+  }
+
+  // The solid's reference configuration is rebuilt from the scene (it never changes); only its map from
+  // particle slots to particle indices follows the stored order, and its stress the stored positions.
+  if (!solids_.empty()) {
+    solids_.reindex(P_);
+    solids_.update_stress(P_);
+  }
 }
 
 Snapshot World::snapshot(const std::string& field, int frame) const {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "checkpoint.hpp"
 #include "contact_dem.hpp"
 #include "fluid_wcsph.hpp"
 #include "kernel.hpp"
@@ -66,8 +67,8 @@ class World {
   // and the scene's max_dt.
   double stable_dt() const;
 
-  // One step of length dt (Algorithm 1). Throws InstabilityError on NaN/Inf, a speed over the limit or
-  // particles leaving the domain beyond the allowed fraction.
+  // One step of length dt (Algorithm 1). Throws InstabilityError on NaN/Inf, a speed over the limit, a
+  // density error over time.max_density_error or particles leaving the domain beyond the allowed fraction.
   void step(double dt);
 
   // Advance to exactly t_target, shortening the last step (SPEC: outputs at exact times). on_step() is
@@ -120,6 +121,13 @@ class World {
   double max_density_error() const;
   // Bytes held by particle arrays and neighbour lists.
   std::size_t memory_bytes() const;
+
+  // Checkpoint (sim/checkpoint.hpp): save_state() writes every piece of state that step() reads (time,
+  // counters, all particle arrays, rigid bodies, the Verlet lists' build positions), so that a World built
+  // from the same scene and given load_state() continues bitwise as the saved one would have. load_state()
+  // throws SetupError when the checkpoint does not fit this scene. New state: add a section to both.
+  void save_state(StateWriter& out) const;
+  void load_state(const StateReader& in);
 
   // What the renderer needs; field is one of material, speed, pressure, displacement, stress.
   Snapshot snapshot(const std::string& field, int frame) const;

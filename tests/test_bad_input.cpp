@@ -1,0 +1,207 @@
+// Bad input never crashes (SPEC.md section 5, issue 7): each malformed scene or argument below exits 2 with a
+// message that names the problem (the JSON path, the option, the file, the resource).
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("aortasph_bad_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+int run_cli(const std::string& args, std::string& err) {
+  const fs::path e = fs::temp_directory_path() / ("aortasph_bad_err_" + std::to_string(::getpid()));
+  const std::string cmd = std::string(AORTASPH_BINARY) + " " + args + " > /dev/null 2> " + e.string();
+  const int status = std::system(cmd.c_str());
+  err = slurp(e);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// A small valid scene with a camera; each row below breaks one thing.
+const char* kGood = R"({
+  "name": "tiny",
+  "domain": { "min": [-0.1, -0.1, -0.1], "max": [0.3, 0.3, 0.2], "max_leave_fraction": 0.0 },
+  "resolution": { "spacing": 0.01, "smoothing_ratio": 1.3 },
+  "time": { "end": 0.002, "output_interval": 0.001, "cfl": 0.25 },
+  "gravity": [0, -9.81, 0],
+  "materials": { "water": { "type": "fluid", "density": 1000, "viscosity": 1e-6, "sound_speed": 10 },
+                 "rubber": { "type": "elastic", "density": 1100, "youngs_modulus": 2e6, "poisson_ratio": 0.45 },
+                 "wall": { "type": "wall" } },
+  "bodies": [
+    { "name": "column", "material": "water", "velocity": [0, 0, 0],
+      "shape": { "box": { "min": [0, 0, 0], "max": [0.05, 0.1, 0.03] } } },
+    { "name": "tank", "material": "wall", "shape": { "container": { "min": [0, 0, 0], "max": [0.2, 0.15, 0.03], "layers": 3, "open": ["+y"] } } }
+  ],
+  "probes": [ { "name": "front", "type": "extent", "bodies": ["column"], "axis": "x", "stat": "max" } ],
+  "render": { "width": 64, "height": 48,
+              "cameras": [ { "name": "front", "eye": [0.1, 0.08, 0.5], "target": [0.1, 0.05, 0.015], "fov_deg": 35 } ],
+              "figures": [ { "name": "fig", "camera": "front", "times": [0, 0.002] } ] }
+})";
+
+std::string replace(std::string s, const std::string& from, const std::string& to) {
+  const auto at = s.find(from);
+  if (at == std::string::npos) throw std::runtime_error("test table: '" + from + "' not in the scene");
+  return s.replace(at, from.size(), to);
+}
+
+struct Case {
+  std::string what;
+  std::string scene;   // file content
+  std::string args;    // extra arguments
+  std::string expect;  // a substring of the message that names the problem
+};
+
+}  // namespace
+
+TEST_CASE("bad input: malformed scenes and arguments exit 2 naming the problem", "[bad-input][cli]") {
+  const fs::path dir = scratch("table");
+  const std::string good = kGood;
+  const std::vector<Case> cases = {
+      // Syntax errors.
+      {"trailing comma", replace(good, "\"tiny\",", "\"tiny\",,"), "", "not valid JSON"},
+      {"unterminated string", replace(good, "\"tiny\"", "\"tiny"), "", "not valid JSON"},
+      {"empty file", "", "", "not valid JSON"},
+      {"not an object", "[1, 2, 3]", "", "scene: expected an object, got a list"},
+      // Wrong types.
+      {"spacing is a string", replace(good, "\"spacing\": 0.01", "\"spacing\": \"fine\""), "",
+       "resolution.spacing: expected a number, got a string"},
+      {"gravity has 2 numbers", replace(good, "[0, -9.81, 0]", "[0, -9.81]"), "",
+       "gravity: expected 3 numbers, got 2"},
+      {"velocity entry not a number",
+       replace(good, "\"velocity\": [0, 0, 0]", "\"velocity\": [0, \"up\", 0]"), "",
+       "bodies[0].velocity[1]: expected a number"},
+      {"bodies is an object", good, "--set 'bodies={}'", "bodies: expected a non-empty list"},
+      {"boolean where a string belongs", replace(good, "\"axis\": \"x\"", "\"axis\": true"), "",
+       "probes[0].axis: expected a string, got a boolean"},
+      // Missing keys and typos.
+      {"missing density", replace(good, "\"density\": 1000, ", ""), "", "materials.water.density: missing"},
+      {"missing domain",
+       replace(good,
+               "\"domain\": { \"min\": [-0.1, -0.1, -0.1], \"max\": [0.3, 0.3, 0.2], \"max_leave_fraction\": "
+               "0.0 },",
+               ""),
+       "", "domain: missing"},
+      {"misspelt key", replace(good, "\"gravity\"", "\"gravitee\""), "", "gravitee: unknown key"},
+      {"missing shape", replace(good, "\"shape\": { \"box\"", "\"form\": { \"box\""), "", "bodies[0].form"},
+      // Out-of-range values.
+      {"negative spacing", replace(good, "\"spacing\": 0.01", "\"spacing\": -0.01"), "",
+       "resolution.spacing: must be positive"},
+      {"smoothing ratio 5", replace(good, "\"smoothing_ratio\": 1.3", "\"smoothing_ratio\": 5"), "",
+       "resolution.smoothing_ratio: must lie in 1..3"},
+      {"cfl above 1", replace(good, "\"cfl\": 0.25", "\"cfl\": 2"), "", "time.cfl"},
+      {"Poisson ratio 0.6", replace(good, "\"poisson_ratio\": 0.45", "\"poisson_ratio\": 0.6"), "",
+       "materials.rubber.poisson_ratio: must lie in (-1, 0.5)"},
+      {"leave fraction 2", replace(good, "\"max_leave_fraction\": 0.0", "\"max_leave_fraction\": 2"), "",
+       "domain.max_leave_fraction"},
+      {"inverted domain", replace(good, "\"max\": [0.3, 0.3, 0.2]", "\"max\": [0.3, -0.3, 0.2]"), "",
+       "domain.max: must be greater than min"},
+      {"zero layers", replace(good, "\"layers\": 3", "\"layers\": 0"), "",
+       "bodies[1].shape.container.layers"},
+      {"unknown open face", replace(good, "[\"+y\"]", "[\"+w\"]"), "", "bodies[1].shape.container.open[0]"},
+      {"odd frame width", replace(good, "\"width\": 64", "\"width\": 65"), "", "render.width: must be even"},
+      {"field of view 180", replace(good, "\"fov_deg\": 35", "\"fov_deg\": 180"), "",
+       "render.cameras[0].fov_deg"},
+      {"figure time after the end", replace(good, "\"times\": [0, 0.002]", "\"times\": [0, 0.5]"), "",
+       "render.figures[0].times[1]"},
+      {"number beyond the double range", replace(good, "\"density\": 1000", "\"density\": 1e999"), "",
+       "number overflow parsing '1e999'"},
+      {"negative density-error limit", good, "--set time.max_density_error=-1", "time.max_density_error"},
+      // References that do not resolve.
+      {"unknown material", replace(good, "\"material\": \"water\"", "\"material\": \"blood\""), "",
+       "bodies[0].material: unknown material 'blood'"},
+      {"unknown probe body", replace(good, "\"bodies\": [\"column\"]", "\"bodies\": [\"colum\"]"), "",
+       "probes[0].bodies[0]: unknown body 'colum'"},
+      {"duplicate body name", replace(good, "\"name\": \"tank\"", "\"name\": \"column\""), "",
+       "duplicate body name 'column'"},
+      {"overlapping bodies",
+       replace(good, "\"min\": [0, 0, 0], \"max\": [0.05", "\"min\": [-0.02, 0, 0], \"max\": [0.05"), "",
+       "overlap"},
+      // Huge particle counts and outputs: refused before anything is allocated or written.
+      {"lattice of 1e15 points", replace(good, "\"spacing\": 0.01", "\"spacing\": 1e-5"), "",
+       "too many particles"},
+      {"more memory than the machine has",
+       replace(replace(good, "\"max\": [0.05, 0.1, 0.03]", "\"max\": [0.57, 0.57, 0.57]"),
+               "\"spacing\": 0.01", "\"spacing\": 0.001"),
+       "--set domain.max=[1,1,1]", "of memory"},
+      {"more frames than the disk holds",
+       replace(replace(good, "\"width\": 64, \"height\": 48", "\"width\": 16384, \"height\": 16384"),
+               "\"output_interval\": 0.001", "\"output_interval\": 0.00001"),
+       "--set time.end=1", "are free on"},
+      // Files and arguments.
+      {"missing scene file", "", "MISSING", "no_such_scene.json: no such scene file"},
+      {"unknown --set path", good, "--set resolution.spacin=0.004", "resolution.spacin"},
+      {"--set value of the wrong type", good, "--set time.end=soon",
+       "time.end: expected a number, got a string"},
+      {"negative --end-time", good, "--end-time -1", "--end-time"},
+      {"zero --checkpoint-every", good, "--checkpoint-every 0", "--checkpoint-every"},
+      {"unwritable --out", good, "--out /proc/aortasph_cannot_write", "/proc/aortasph_cannot_write"},
+  };
+  REQUIRE(cases.size() >= 20);
+  for (const Case& c : cases) {
+    const fs::path scene = dir / "scene.json";
+    std::ofstream(scene, std::ios::trunc) << c.scene;
+    std::string args = "run " + scene.string() + " --quiet " + c.args;
+    if (c.args == "MISSING") args = "run " + (dir / "no_such_scene.json").string() + " --quiet";
+    if (c.args.find("--out") == std::string::npos) args += " --out " + (dir / "out").string();
+    std::string err;
+    const int code = run_cli(args, err);
+    INFO(c.what << ": exit " << code << ", stderr: " << err);
+    CHECK(code == 2);
+    CHECK(err.find(c.expect) != std::string::npos);
+    CHECK(err.find("internal error") == std::string::npos);
+  }
+  // resume without a checkpoint.
+  std::string err;
+  CHECK(run_cli("resume " + (dir / "nothing_here").string(), err) == 2);
+  CHECK(err.find("no checkpoint") != std::string::npos);
+}
+
+TEST_CASE("bad input: a write error during a run (disk full) exits 2 naming the file", "[bad-input][cli]") {
+  const fs::path dir = scratch("full");
+  std::ofstream(dir / "scene.json") << kGood;
+  fs::create_directories(dir / "out");
+  // probes.csv is a link to /dev/full: every write fails with ENOSPC, as on a full disk.
+  fs::create_symlink("/dev/full", dir / "out" / "probes.csv");
+  std::string err;
+  const int code =
+      run_cli("run " + (dir / "scene.json").string() + " --quiet --out " + (dir / "out").string(), err);
+  INFO(err);
+  CHECK(code == 2);
+  CHECK(err.find("probes.csv: write failed") != std::string::npos);
+}
+
+TEST_CASE("bad input: a frame that cannot be written stops the run with exit 2, no partial PNG",
+          "[bad-input][cli]") {
+  const fs::path dir = scratch("frame");
+  std::ofstream(dir / "scene.json") << kGood;
+  // A directory where the PNG's temporary file must go: the write of frame 1 fails (as on a full disk).
+  fs::create_directories(dir / "out" / "frames" / "front" / "frame_00001.png.tmp");
+  std::string err;
+  const int code =
+      run_cli("run " + (dir / "scene.json").string() + " --quiet --out " + (dir / "out").string(), err);
+  INFO(err);
+  CHECK(code == 2);
+  CHECK(err.find("rendering failed") != std::string::npos);
+  CHECK(err.find("frame_00001.png") != std::string::npos);
+  CHECK(fs::exists(dir / "out" / "frames" / "front" / "frame_00000.png"));
+  CHECK_FALSE(fs::exists(dir / "out" / "frames" / "front" / "frame_00001.png"));
+  CHECK(slurp(dir / "out" / "run.json").find("\"status\": \"failed\"") != std::string::npos);
+}
