@@ -542,7 +542,24 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
                 kTypes[static_cast<int>(b.type)], b.count);
   const std::size_t n = world.particles().size();
   const std::size_t nf = world.count(Kind::Fluid);
-  std::printf("  total %zu particles (%zu fluid, %zu boundary)\n", n, nf, n - nf);
+  const std::size_t nin = world.count(Kind::Inflow), nout = world.count(Kind::Outflow);
+  if (scene.open_boundaries.empty())
+    std::printf("  total %zu particles (%zu fluid, %zu boundary)\n", n, nf, n - nf);
+  else
+    std::printf("  total %zu particles (%zu fluid, %zu inflow buffer, %zu outflow buffer, %zu boundary)\n", n,
+                nf, nin, nout, n - nf - nin - nout);
+  for (const OpenBoundarySpec& o : scene.open_boundaries) {
+    if (o.type == OpenBoundaryType::Inflow)
+      std::printf("  inflow  %-12s radius %g m, %d layers, %s profile, velocity %g m/s at t = 0\n",
+                  o.name.c_str(), o.radius, o.layers, o.parabolic ? "parabolic" : "uniform",
+                  o.velocity.at(0.0));
+    else
+      std::printf("  outflow %-12s radius %g m, %d layers, pressure %g Pa at t = 0\n", o.name.c_str(),
+                  o.radius, o.layers, o.pressure.at(0.0));
+  }
+  if (!scene.open_boundaries.empty())
+    std::printf("  prescribed inflow: %g m^3/s at t = 0\n",
+                world.open_boundaries().prescribed_inflow_rate(0.0));
   const double dt = world.stable_dt();
   const double steps = std::ceil(scene.t_end / dt);
   const double neighbors = n ? static_cast<double>(world.neighbors().pairs()) / static_cast<double>(n) : 0.0;

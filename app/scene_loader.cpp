@@ -175,7 +175,7 @@ class Loader {
     Scene s;
     Obj top(root, "",
             {"name", "description", "domain", "resolution", "time", "gravity", "materials", "contact",
-             "bodies", "probes", "render"},
+             "bodies", "open_boundaries", "probes", "render"},
             allowed);
     s.name = top.string("name");
     if (s.name.empty() || s.name.find('/') != std::string::npos || s.name == "." || s.name == "..")
@@ -226,6 +226,18 @@ class Loader {
         if (s.bodies[b].name == s.bodies[c].name)
           fail(index("bodies", b) + ".name", "duplicate body name '" + s.bodies[b].name + "'");
     if (s.bodies.size() > 60000) fail("bodies", "too many bodies");
+
+    if (top.has("open_boundaries")) {
+      json& obs = top.raw("open_boundaries");
+      if (!obs.is_array()) fail("open_boundaries", "expected a list, got " + type_name(obs));
+      for (std::size_t k = 0; k < obs.size(); ++k) {
+        s.open_boundaries.push_back(open_boundary(obs[k], index("open_boundaries", k), s));
+        for (std::size_t q = 0; q < k; ++q)
+          if (s.open_boundaries[q].name == s.open_boundaries[k].name)
+            fail(index("open_boundaries", k) + ".name",
+                 "duplicate open boundary name '" + s.open_boundaries[k].name + "'");
+      }
+    }
 
     if (!top.has("probes")) root["probes"] = json::array();
     json& probes = top.raw("probes");
@@ -412,6 +424,77 @@ class Loader {
     return sh;
   }
 
+  // A constant or a table [[t, value], ...] with strictly increasing times (linear in between, held outside).
+  TimeSeries series(Obj& o, const std::string& key, std::optional<double> def, bool non_negative) {
+    if (!o.has(key) && def) return TimeSeries{{}, {o.number(key, def)}};
+    json& v = o.raw(key);
+    TimeSeries ts;
+    auto check = [&](double x, const std::string& path) {
+      if (non_negative && x < 0) fail(path, "must not be negative, got " + json(x).dump());
+    };
+    if (v.is_number()) {
+      const double x = o.number(key);
+      check(x, o.path(key));
+      ts.value = {x};
+      return ts;
+    }
+    if (!v.is_array() || v.empty())
+      fail(o.path(key), "expected a number or a table [[t, value], ...], got " + type_name(v));
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      const std::string p = index(o.path(key), k);
+      const json& row = v[k];
+      if (!row.is_array() || row.size() != 2 || !row[0].is_number() || !row[1].is_number())
+        fail(p, "expected a pair [t, value] of numbers");
+      const double t = row[0].get<double>(), x = row[1].get<double>();
+      if (!std::isfinite(t) || !std::isfinite(x)) fail(p, "expected finite numbers");
+      if (!ts.t.empty() && !(t > ts.t.back()))
+        fail(p,
+             "times must increase strictly (" + json(t).dump() + " after " + json(ts.t.back()).dump() + ")");
+      check(x, p);
+      ts.t.push_back(t);
+      ts.value.push_back(x);
+    }
+    return ts;
+  }
+
+  OpenBoundarySpec open_boundary(json& j, const std::string& path, const Scene& s) {
+    if (!j.is_object()) fail(path, "expected an object, got " + type_name(j));
+    const std::string type = j.contains("type") && j["type"].is_string() ? j["type"].get<std::string>() : "";
+    if (j.contains("type") && type != "inflow" && type != "outflow")
+      fail(path + ".type", "unknown value " + j["type"].dump() + " (expected one of: inflow, outflow)");
+    std::vector<std::string> keys = {"name", "type", "point", "normal", "radius", "layers"};
+    if (type == "inflow") keys.insert(keys.end(), {"body", "velocity", "profile"});
+    if (type == "outflow") keys.insert(keys.end(), {"pressure"});
+    Obj o(j, path, keys, allowed);
+    OpenBoundarySpec b;
+    b.name = o.string("name");
+    if (b.name.empty()) fail(o.path("name"), "must not be empty");
+    b.type = o.choice("type", {"inflow", "outflow"}) == "inflow" ? OpenBoundaryType::Inflow
+                                                                 : OpenBoundaryType::Outflow;
+    b.point = o.vec3("point");
+    b.normal = o.unit("normal");
+    b.radius = o.positive("radius");
+    b.layers = o.integer("layers", 4, 1, 50);
+    // The buffer must cover the kernel support 2h of the fluid next to the disc.
+    const int min_layers = static_cast<int>(std::ceil(2.0 * s.smoothing_ratio - 1e-9));
+    if (b.layers < min_layers)
+      fail(o.path("layers"),
+           "must be at least " + std::to_string(min_layers) +
+               " (the buffer must cover the kernel support 2h = " + json(2.0 * s.smoothing_ratio).dump() +
+               " spacings), got " + std::to_string(b.layers));
+    if (b.type == OpenBoundaryType::Inflow) {
+      b.body = body_index(s, o.string("body"), o.path("body"));
+      if (s.materials[s.bodies[b.body].material].type != MaterialType::Fluid)
+        fail(o.path("body"),
+             "body '" + s.bodies[b.body].name + "' is not a fluid (an inflow feeds a fluid body)");
+      b.velocity = series(o, "velocity", std::nullopt, true);
+      b.parabolic = o.choice("profile", {"uniform", "parabolic"}, "uniform") == "parabolic";
+    } else {
+      b.pressure = series(o, "pressure", 0.0, false);
+    }
+    return b;
+  }
+
   Probe probe(json& j, const std::string& path, const Scene& s) {
     if (!j.is_object()) fail(path, "expected an object, got " + type_name(j));
     const std::string type = j.contains("type") && j["type"].is_string() ? j["type"].get<std::string>() : "";
@@ -427,8 +510,8 @@ class Loader {
     p.name = o.string("name");
     if (p.name.empty() || p.name.find_first_of(",\"\n") != std::string::npos)
       fail(o.path("name"), "must be a non-empty name without commas or quotes");
-    o.choice("type",
-             {"extent", "pressure", "body", "point", "energy", "momentum", "flow_rate", "orifice_area"});
+    o.choice("type", {"extent", "pressure", "body", "point", "energy", "momentum", "flow_rate",
+                      "orifice_area", "open_boundary"});
     if (type == "extent") {
       p.type = ProbeType::Extent;
       const auto names = o.strings("bodies");
@@ -456,6 +539,9 @@ class Loader {
       p.type = ProbeType::Energy;
     } else if (type == "momentum") {
       p.type = ProbeType::Momentum;
+    } else if (type == "open_boundary") {
+      p.type = ProbeType::OpenBoundary;
+      if (s.open_boundaries.empty()) fail(o.path("type"), "the scene has no open_boundaries");
     } else if (type == "flow_rate") {
       p.type = ProbeType::FlowRate;
       p.point = o.vec3("point");

@@ -8,12 +8,12 @@ void boundary_from_fluid(Particles& P, const NeighborSearch& nb, const FluidCont
                          const FluidParams& ref) {
   const auto& idx = nb.index();
   parallel_for_dynamic(P.size(), [&](std::size_t w) {
-    if (P.kind[w] == Kind::Fluid) return;
+    if (fluid_like(P.kind[w])) return;  // fluid, and open-boundary buffers (sim/open_boundary.hpp)
     double sum_w = 0.0, sum_pw = 0.0;
     Vec3 sum_rho_x = Vec3::Zero(), sum_v = Vec3::Zero();
     for (uint32_t k = nb.begin(w); k < nb.end(w); ++k) {
       const uint32_t f = idx[k];
-      if (P.kind[f] != Kind::Fluid) continue;
+      if (!fluid_like(P.kind[f])) continue;
       const Vec3 xwf = P.x[w] - P.x[f];
       const double W = ctx.kernel.W(xwf.norm());
       sum_w += W;

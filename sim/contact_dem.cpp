@@ -33,11 +33,11 @@ void contact_forces(const Particles& P, const NeighborSearch& nb, const ContactP
   const auto& idx = nb.index();
   const double d2 = c.distance * c.distance;
   parallel_for_dynamic(P.size(), [&](std::size_t i) {
-    if (P.kind[i] == Kind::Fluid) return;
+    if (fluid_like(P.kind[i])) return;
     Vec3 sum = Vec3::Zero(), mom = Vec3::Zero();
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
-      if (P.kind[j] == Kind::Fluid || P.body[j] == P.body[i]) continue;
+      if (fluid_like(P.kind[j]) || P.body[j] == P.body[i]) continue;
       const Vec3 xij = P.x[i] - P.x[j];
       if (xij.squaredNorm() >= d2) continue;
       const Vec3 fij = contact_force(c, xij, P.v[i] - P.v[j]);

@@ -63,7 +63,7 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
       drho += P.m[j] * dwdr_r * (vi - P.v[j]).dot(xij);
       // Density diffusion (Molteni & Colagrossi 2009, eq. 12) between particles of one fluid, minus the
       // hydrostatic density difference rho0 g.x_ji / c0^2 (Fourtakas et al. 2019, eq. 19, linearised Tait).
-      if (diffusion > 0.0 && P.kind[j] == Kind::Fluid && P.material[j] == P.material[i]) {
+      if (diffusion > 0.0 && fluid_like(P.kind[j]) && P.material[j] == P.material[i]) {
         const double hydro = fi.rho0 * ctx.gravity.dot(P.x[j] - xi) * inv_c2;
         drho -= diffusion * (P.rho[j] - rhoi - hydro) * dwdr_r * ctx.volume[j];
       }
@@ -111,7 +111,7 @@ inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx, const
   const double mj = P.m[j];
   const double rhoi = I.rho;
   const double rhoj = P.rho[j];
-  const bool fluid_j = P.kind[j] == Kind::Fluid;
+  const bool fluid_j = fluid_like(P.kind[j]);  // open-boundary buffer particles count as fluid
   const Vec3 vij = I.v - P.v[j];
 
   // Pressure, eq. (9) with the 1/rho_i of Algorithm 1 line 9 applied: a_i = -sum m_j (p_i/rho_i^2 +
@@ -161,7 +161,7 @@ void fluid_reaction(const Particles& P, const NeighborSearch& nb, const FluidCon
   const auto& idx = nb.index();
   const PairConstants c(ctx.kernel);
   parallel_for_dynamic(P.size(), [&](std::size_t j) {
-    if (P.kind[j] == Kind::Fluid || P.kind[j] == Kind::Wall) return;
+    if (fluid_like(P.kind[j]) || P.kind[j] == Kind::Wall) return;
     Vec3 sum = Vec3::Zero();
     for (uint32_t k = nb.begin(j); k < nb.end(j); ++k) {
       const uint32_t i = idx[k];

@@ -12,6 +12,12 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// Open-boundary buffer particles stand outside the domain: probes of bodies, energy and momentum leave them
+// out.
+bool is_buffer(Kind k) {
+  return k == Kind::Inflow || k == Kind::Outflow;
+}
+
 struct Sum3 {
   Vec3 a = Vec3::Zero(), b = Vec3::Zero();
   double m = 0.0;
@@ -65,6 +71,11 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
       case ProbeType::Momentum:
         add_columns(columns_, pr.name, {"px", "py", "pz", "lx", "ly", "lz"});
         break;
+      case ProbeType::OpenBoundary:
+        add_columns(columns_, pr.name,
+                    {"volume_in", "volume_out", "volume_inside", "prescribed_rate", "mass_in", "mass_out",
+                     "mass_inside"});
+        break;
       case ProbeType::OrificeArea:
         throw SetupError("probes[" + std::to_string(k) + "] '" + pr.name +
                          "': orifice_area needs an elastic valve, which this version cannot simulate yet");
@@ -90,7 +101,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const double best = parallel_reduce(
             n, -std::numeric_limits<double>::infinity(),
             [&](std::size_t i) {
-              if (!in_set[P.body[i]] || (pr.region && !pr.region->contains(P.x[i])))
+              if (!in_set[P.body[i]] || is_buffer(P.kind[i]) || (pr.region && !pr.region->contains(P.x[i])))
                 return -std::numeric_limits<double>::infinity();
               return sign * P.x[i][pr.axis];
             },
@@ -129,7 +140,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const Sum3 s = parallel_reduce(
             n, Sum3{},
             [&](std::size_t i) {
-              if (P.body[i] != pr.body) return Sum3{};
+              if (P.body[i] != pr.body || is_buffer(P.kind[i])) return Sum3{};
               const double m = world.inertial_mass(i);
               return Sum3{m * P.x[i], m * P.v[i], m};
             },
@@ -165,7 +176,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const E e = parallel_reduce(
             n, E{},
             [&](std::size_t i) {
-              if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid) return E{};
+              if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid || is_buffer(P.kind[i])) return E{};
               const double m = world.inertial_mass(i);
               return E{0.5 * m * P.v[i].squaredNorm(), -m * g.dot(P.x[i])};
             },
@@ -187,7 +198,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const Sum3 t = parallel_reduce(
             n, Sum3{},
             [&](std::size_t i) {
-              if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid) return Sum3{};
+              if (P.kind[i] == Kind::Wall || P.kind[i] == Kind::Rigid || is_buffer(P.kind[i])) return Sum3{};
               const Vec3 p = world.inertial_mass(i) * P.v[i];
               return Sum3{p, P.x[i].cross(p), 0.0};
             },
@@ -215,6 +226,29 @@ std::vector<double> ProbeSet::measure(const World& world) const {
             },
             [](double a, double b) { return a + b; });
         out.push_back(q / d);
+        break;
+      }
+      case ProbeType::OpenBoundary: {
+        // Cumulative volumes through the open boundaries (m / rho of each particle as it crossed a disc), the
+        // fluid volume inside now (sum of m / rho over fluid particles, buffers excluded) and the prescribed
+        // inflow rate now; then the same as masses. Volume balance: volume_in - volume_out = change of
+        // volume_inside, up to the fluid's change of density (weakly compressible); mass balance: exact, up
+        // to particles that leave the domain elsewhere.
+        const OpenBoundaries& ob = world.open_boundaries();
+        struct VM {
+          double v = 0, m = 0;
+        };
+        const VM inside = parallel_reduce(
+            n, VM{},
+            [&](std::size_t i) {
+              return P.kind[i] == Kind::Fluid ? VM{P.m[i] / P.rho[i], P.m[i]} : VM{};
+            },
+            [](const VM& a, const VM& b) {
+              return VM{a.v + b.v, a.m + b.m};
+            });
+        const OpenBoundaryState& st = ob.state();
+        out.insert(out.end(), {st.volume_in, st.volume_out, inside.v, ob.prescribed_inflow_rate(world.time()),
+                               st.mass_in, st.mass_out, inside.m});
         break;
       }
       case ProbeType::OrificeArea:

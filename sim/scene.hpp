@@ -82,7 +82,17 @@ struct Contact {
   double friction = 0.5;   // Coulomb bound on the shear force
 };
 
-enum class ProbeType { Extent, Pressure, BodyState, Point, Energy, Momentum, FlowRate, OrificeArea };
+enum class ProbeType {
+  Extent,
+  Pressure,
+  BodyState,
+  Point,
+  Energy,
+  Momentum,
+  FlowRate,
+  OrificeArea,
+  OpenBoundary
+};
 
 struct Probe {
   std::string name;
@@ -96,6 +106,39 @@ struct Probe {
   Vec3 normal = Vec3::UnitY();    // flow_rate, orifice_area
   Vec3 reference = Vec3::Zero();  // point
   double radius = 0.0;            // flow_rate
+};
+
+// A value that may vary in time: one constant, or a table of (t, value) pairs with strictly increasing times,
+// interpolated linearly and held at its first / last value outside the table.
+struct TimeSeries {
+  std::vector<double> t;      // empty for a constant
+  std::vector<double> value;  // one entry for a constant
+  double at(double time) const {
+    if (t.empty()) return value.empty() ? 0.0 : value[0];
+    if (time <= t.front()) return value.front();
+    if (time >= t.back()) return value.back();
+    std::size_t k = 1;
+    while (t[k] < time) ++k;
+    const double w = (time - t[k - 1]) / (t[k] - t[k - 1]);
+    return value[k - 1] + w * (value[k] - value[k - 1]);
+  }
+};
+
+enum class OpenBoundaryType { Inflow, Outflow };
+
+// An inflow or outflow (docs/scenes.md, sim/open_boundary.hpp): a buffer cylinder of `layers` particle layers
+// behind (inflow) or beyond (outflow) the disc of centre `point`, unit `normal` and `radius`.
+struct OpenBoundarySpec {
+  std::string name;
+  OpenBoundaryType type = OpenBoundaryType::Inflow;
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::UnitY();  // inflow: into the domain; outflow: out of the domain
+  double radius = 0.0;
+  int layers = 4;
+  int body = -1;           // inflow: the fluid body that the entering particles join
+  TimeSeries velocity;     // inflow: mean velocity over the inlet [m/s]
+  bool parabolic = false;  // inflow: Poiseuille profile instead of uniform
+  TimeSeries pressure;     // outflow: pressure at the outlet face [Pa]
 };
 
 struct Camera {
@@ -148,6 +191,7 @@ struct Scene {
   std::vector<Material> materials;
   Contact contact;
   std::vector<Body> bodies;
+  std::vector<OpenBoundarySpec> open_boundaries;
   std::vector<Probe> probes;
   RenderSettings render;
 };

@@ -81,6 +81,10 @@ void cylinder_mesh(const Vec3& base, const Vec3& a, double r, double L, bool inw
 
 }  // namespace
 
+void perpendicular_frame(const Vec3& axis, Vec3& u, Vec3& v) {
+  frame(axis.normalized(), u, v);
+}
+
 Vec3 shape_center(const Shape& s) {
   switch (s.kind) {
     case ShapeKind::Box:

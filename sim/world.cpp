@@ -176,6 +176,9 @@ World::World(const Scene& scene)
                          ": particles closer than half a spacing");
     }
 
+  // Inflow buffer particles join the bodies; fluid already beyond an outlet disc becomes outflow buffer.
+  if (!scene_.open_boundaries.empty()) open_.setup(scene_, fluid_, P_);
+
   for (std::size_t i = 0; i < P_.size(); ++i)
     if (P_.kind[i] != Kind::Wall) ++moving_at_start_;
   speed_limit_ = scene_.max_speed > 0.0 ? scene_.max_speed : (max_c0_ > 0.0 ? 2.0 * max_c0_ : 1e3);
@@ -305,6 +308,19 @@ void World::step(double dt) {
 
   t0 = Clock::now();
   integrate(dt);
+  profile_.integrate += seconds_since(t0);
+
+  // Open boundaries (sim/open_boundary.hpp): buffers move, particles that crossed an inlet or outlet disc
+  // change role, are created at inflows and removed at outflows (those never count as leaving the domain).
+  // Created or removed particles invalidate the neighbour lists.
+  t0 = Clock::now();
+  if (!open_.empty() && open_.update(P_, nb_, kernel_, gravity_, time_ + dt, dt)) {
+    lists_valid_ = false;
+    solids_.reindex(P_);  // particles were appended and removed: the solid's slots follow (by particle id)
+  }
+  profile_.open_boundary += seconds_since(t0);
+
+  t0 = Clock::now();
   check_and_remove(dt);
   profile_.integrate += seconds_since(t0);
 
@@ -519,6 +535,13 @@ void World::save_state(StateWriter& out) const {
     r.vec3(b.L);
   }
 
+  SectionWriter& ob = out.section("open_boundaries", 1);
+  const OpenBoundaryState& os = open_.state();
+  ob.value(os.next_id);
+  for (double v : {os.volume_in, os.volume_out, os.mass_in, os.mass_out}) ob.value(v);
+  ob.value(os.created);
+  ob.value(os.removed);
+
   // The Verlet lists are rebuilt from the positions of their last build (and the rebuild and sort schedule
   // continues from builds_), so the resumed run sees the very lists the saved one had.
   SectionWriter& nb = out.section("neighbors", 1);
@@ -537,14 +560,18 @@ void World::load_state(const StateReader& in) {
   left_domain_ = static_cast<std::size_t>(w.value<uint64_t>());
   const auto moving = w.value<uint64_t>();
   if (moving != moving_at_start_) w.mismatch("moving particles at t = 0", moving, moving_at_start_);
-  double* phases[] = {&profile_.neighbors, &profile_.density, &profile_.boundary,  &profile_.forces,
-                      &profile_.solid,     &profile_.rigid,   &profile_.integrate, &profile_.sort};
+  // In the order of Profile::phases(), which save_state wrote.
+  double* phases[] = {&profile_.neighbors, &profile_.density,       &profile_.boundary,
+                      &profile_.forces,    &profile_.solid,         &profile_.rigid,
+                      &profile_.integrate, &profile_.open_boundary, &profile_.sort};
+  if (profile_.phases().size() != std::size(phases)) throw std::logic_error("load_state: profile phases");
   for (double* sec : phases) *sec = w.value<double>();
   w.done();
 
   SectionReader p = in.section("particles");
   const auto n = static_cast<std::size_t>(p.value<uint64_t>());
-  if (n > P_.size()) p.mismatch("particles", n, P_.size());  // particles are removed, never added (yet)
+  // Particles leave the domain; open boundaries also create them, so only scenes without one bound n.
+  if (open_.empty() && n > P_.size()) p.mismatch("particles", n, P_.size());
   P_.for_each_array([&](const char* name, auto& array) {
     const std::string stored = p.string();
     if (stored != name)
@@ -556,7 +583,7 @@ void World::load_state(const StateReader& in) {
   p.done();
   for (std::size_t i = 0; i < n; ++i)
     if (P_.body[i] >= bodies_.size() || P_.material[i] >= scene_.materials.size() ||
-        static_cast<uint8_t>(P_.kind[i]) > static_cast<uint8_t>(Kind::Elastic))
+        static_cast<uint8_t>(P_.kind[i]) > static_cast<uint8_t>(Kind::Outflow))
       throw SetupError("checkpoint section 'particles': particle " + std::to_string(i) +
                        " refers to a body or material this scene does not have");
 
@@ -573,6 +600,14 @@ void World::load_state(const StateReader& in) {
     b.L = r.vec3();
   }
   r.done();
+
+  SectionReader ob = in.section("open_boundaries");
+  OpenBoundaryState& os = open_.state();
+  os.next_id = ob.value<uint32_t>();
+  for (double* v : {&os.volume_in, &os.volume_out, &os.mass_in, &os.mass_out}) *v = ob.value<double>();
+  os.created = ob.value<uint64_t>();
+  os.removed = ob.value<uint64_t>();
+  ob.done();
 
   SectionReader nb = in.section("neighbors");
   lists_valid_ = nb.value<bool>();

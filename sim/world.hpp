@@ -11,6 +11,7 @@
 #include "fluid_wcsph.hpp"
 #include "kernel.hpp"
 #include "neighbors.hpp"
+#include "open_boundary.hpp"
 #include "particles.hpp"
 #include "rigid_body.hpp"
 #include "scene.hpp"
@@ -21,16 +22,33 @@ namespace aortasph {
 
 // Wall time per phase of the step, summed over steps [s].
 struct Profile {
-  double neighbors = 0, density = 0, boundary = 0, forces = 0, solid = 0, rigid = 0, integrate = 0, sort = 0;
-  double total() const { return neighbors + density + boundary + forces + solid + rigid + integrate + sort; }
+  double neighbors = 0, density = 0, boundary = 0, forces = 0, solid = 0, rigid = 0, integrate = 0,
+         open_boundary = 0, sort = 0;
+  double total() const {
+    return neighbors + density + boundary + forces + solid + rigid + integrate + open_boundary + sort;
+  }
   // (name, seconds) of each phase, in step order: the one list that diagnostics, run.json and bench print.
   std::vector<std::pair<std::string, double>> phases() const {
-    return {{"neighbors", neighbors}, {"density", density}, {"boundary", boundary},   {"forces", forces},
-            {"solid", solid},         {"rigid", rigid},     {"integrate", integrate}, {"sort", sort}};
+    return {{"neighbors", neighbors},
+            {"density", density},
+            {"boundary", boundary},
+            {"forces", forces},
+            {"solid", solid},
+            {"rigid", rigid},
+            {"integrate", integrate},
+            {"open_boundary", open_boundary},
+            {"sort", sort}};
   }
   Profile operator-(const Profile& o) const {
-    return {neighbors - o.neighbors, density - o.density, boundary - o.boundary,   forces - o.forces,
-            solid - o.solid,         rigid - o.rigid,     integrate - o.integrate, sort - o.sort};
+    return {neighbors - o.neighbors,
+            density - o.density,
+            boundary - o.boundary,
+            forces - o.forces,
+            solid - o.solid,
+            rigid - o.rigid,
+            integrate - o.integrate,
+            open_boundary - o.open_boundary,
+            sort - o.sort};
   }
 };
 
@@ -109,6 +127,7 @@ class World {
   const CubicSpline& kernel() const { return kernel_; }
   const std::vector<FluidParams>& fluid_params() const { return fluid_; }
   const Profile& profile() const { return profile_; }
+  const OpenBoundaries& open_boundaries() const { return open_; }
   double time() const { return time_; }
   long steps() const { return steps_; }
   double last_dt() const { return last_dt_; }
@@ -154,6 +173,7 @@ class World {
   std::vector<BodyInfo> bodies_;
   std::vector<RigidBody> rigid_;
   Solids solids_;
+  OpenBoundaries open_;  // inflows and outflows; their counters are plain values (OpenBoundaryState)
   ContactParams contact_;
   double min_contact_mass_ = std::numeric_limits<double>::max();
   std::vector<Vec3> force_;   // per-particle force on body particles of the current step

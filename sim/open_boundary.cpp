@@ -1,0 +1,385 @@
+#include "open_boundary.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "parallel.hpp"
+#include "shapes.hpp"
+#include "sim_errors.hpp"
+
+namespace aortasph {
+
+namespace {
+
+std::string where(std::size_t k, const OpenBoundarySpec& s) {
+  return "open_boundaries[" + std::to_string(k) + "] '" + s.name + "'";
+}
+
+// What the serial pass does with a particle.
+enum Action : uint8_t {
+  kNone = 0,
+  kInflowToFluid,   // crossed the inlet disc: becomes fluid, a new buffer particle is created behind
+  kFluidToOutflow,  // crossed the outlet disc
+  kOutflowToFluid,  // came back across the outlet disc
+  kRemove,          // passed the outflow buffer's far face
+  kRemoveBackflow,  // fluid that flowed back into an inflow buffer
+};
+
+}  // namespace
+
+double OpenBoundaries::Zone::inflow_speed(const Vec3& x, double t) const {
+  const double V = spec.velocity.at(t);
+  if (!spec.parabolic) return V;
+  // Poiseuille profile V (1 - r^2/R^2) / mean(1 - r^2/R^2): its mean over the inlet's columns is V.
+  const double r = radial(x) / spec.radius;
+  return V * std::max(1.0 - r * r, 0.0) / profile_mean;
+}
+
+void OpenBoundaries::configure(const Scene& scene, const std::vector<FluidParams>& fluid) {
+  fluid_ = fluid;
+  dx_ = scene.spacing;
+  support_ = 2.0 * scene.smoothing_ratio * scene.spacing;
+  const double dx = dx_;
+  zones_.clear();
+  for (std::size_t k = 0; k < scene.open_boundaries.size(); ++k) {
+    const OpenBoundarySpec& s = scene.open_boundaries[k];
+    Zone z;
+    z.spec = s;
+    z.spec.normal = s.normal.normalized();
+    perpendicular_frame(z.spec.normal, z.u, z.v);
+    z.depth = s.layers * dx;
+    // The buffer must lie inside the domain, an outflow's with one more layer (particles pass its far face
+    // before they are removed), or particles would count as leaving the domain.
+    const double far = s.type == OpenBoundaryType::Inflow ? -z.depth : z.depth + dx;
+    for (const double a : {0.0, far})
+      for (int c = 0; c < 4; ++c) {
+        const double ang = c * 0.5 * 3.14159265358979323846;
+        const Vec3 x = s.point + a * z.spec.normal + s.radius * (std::cos(ang) * z.u + std::sin(ang) * z.v);
+        if (!scene.domain.contains(x))
+          throw SetupError(where(k, s) + ": the buffer (" + std::to_string(s.layers) +
+                           " layers) reaches outside the domain");
+      }
+    if (s.type == OpenBoundaryType::Inflow) {
+      if (s.body < 0 || s.body >= static_cast<int>(scene.bodies.size()) ||
+          scene.materials.at(scene.bodies[s.body].material).type != MaterialType::Fluid)
+        throw SetupError(where(k, s) + ": an inflow must feed a fluid body");
+      z.material = scene.bodies[s.body].material;
+      // Lattice columns across the disc, laid out like the tube's (shapes.cpp), so that an inlet at a tube's
+      // base continues the tube's lattice.
+      const int nr = static_cast<int>(std::ceil(s.radius / dx));
+      std::vector<Vec3>& columns = z.columns;
+      double sum_profile = 0.0;
+      for (int j = -nr; j < nr; ++j)
+        for (int i = -nr; i < nr; ++i) {
+          const double a = (i + 0.5) * dx, b = (j + 0.5) * dx;
+          const double r = std::hypot(a, b);
+          if (r >= s.radius) continue;
+          columns.push_back(s.point + a * z.u + b * z.v);
+          sum_profile += 1.0 - (r / s.radius) * (r / s.radius);
+        }
+      if (columns.empty())
+        throw SetupError(where(k, s) + ": radius " + std::to_string(s.radius) +
+                         " holds no particle column at spacing " + std::to_string(dx));
+      z.area = static_cast<double>(columns.size()) * dx * dx;
+      z.profile_mean = sum_profile / static_cast<double>(columns.size());
+    }
+    zones_.push_back(z);
+  }
+}
+
+void OpenBoundaries::setup(const Scene& scene, const std::vector<FluidParams>& fluid, Particles& P) {
+  configure(scene, fluid);
+  const double dx = dx_;
+  uint32_t next = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) next = std::max(next, P.id[i] + 1);
+  state_ = OpenBoundaryState{};
+  state_.next_id = next;
+
+  // The inflow buffers: `layers` lattice layers behind each inlet disc.
+  const std::size_t first_buffer = P.size();
+  for (const Zone& z : zones_) {
+    if (z.spec.type != OpenBoundaryType::Inflow) continue;
+    const FluidParams& fp = fluid_.at(z.material);
+    for (int layer = 0; layer < z.spec.layers; ++layer)
+      for (const Vec3& c : z.columns) {
+        const std::size_t i = P.size();
+        P.resize(i + 1);
+        P.x[i] = c - (layer + 0.5) * dx * z.spec.normal;
+        P.x0[i] = P.x[i];
+        P.kind[i] = Kind::Inflow;
+        P.body[i] = static_cast<uint16_t>(z.spec.body);
+        P.material[i] = static_cast<uint16_t>(z.material);
+        P.id[i] = state_.next_id++;
+        P.m[i] = fp.rho0 * dx * dx * dx;
+        P.rho[i] = fp.rho0;
+      }
+  }
+
+  // Inflow buffers must not overlap bodies (nor each other): particles closer than half a spacing.
+  if (P.size() > first_buffer) {
+    NeighborSearch nb;
+    nb.build(P.x, 0.5 * dx);
+    for (std::size_t i = first_buffer; i < P.size(); ++i)
+      for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
+        const uint32_t j = nb.index()[k];
+        const int zi = zone_of(P.x[i], Kind::Inflow);
+        if (j < first_buffer || zone_of(P.x[j], Kind::Inflow) != zi) {
+          std::ostringstream msg;
+          msg << where(static_cast<std::size_t>(zi), zones_[zi].spec) << ": the inflow buffer overlaps "
+              << (j < first_buffer ? "body '" + scene.bodies[P.body[j]].name + "'" : std::string("another"))
+              << " near (" << P.x[i].x() << ", " << P.x[i].y() << ", " << P.x[i].z() << ")";
+          throw SetupError(msg.str());
+        }
+      }
+  }
+
+  // Fluid that starts beyond an outlet disc is in the outflow buffer from the start (not counted as out).
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (P.kind[i] == Kind::Fluid && zone_of(P.x[i], Kind::Outflow) >= 0 &&
+        zones_[zone_of(P.x[i], Kind::Outflow)].axial(P.x[i]) >= 0.0)
+      P.kind[i] = Kind::Outflow;
+  impose(P, scene.gravity, 0.0);
+  for (std::size_t i = first_buffer; i < P.size(); ++i) {
+    const Zone& z = zones_[zone_of(P.x[i], Kind::Inflow)];
+    P.v[i] = z.inflow_speed(P.x[i], 0.0) * z.spec.normal;
+    P.v_wall[i] = P.v[i];
+  }
+}
+
+int OpenBoundaries::zone_of(const Vec3& x, Kind kind) const {
+  // A little slack around each buffer: particles move up to a fraction of a spacing per step.
+  for (std::size_t k = 0; k < zones_.size(); ++k) {
+    const Zone& z = zones_[k];
+    if (z.radial(x) > z.spec.radius + 0.5 * dx_) continue;
+    const double a = z.axial(x);
+    if (kind == Kind::Inflow && z.spec.type == OpenBoundaryType::Inflow && a >= -z.depth - 0.5 * dx_ &&
+        a < 0.5 * dx_)
+      return static_cast<int>(k);
+    if (kind == Kind::Outflow && z.spec.type == OpenBoundaryType::Outflow && a >= -support_ &&
+        a <= z.depth + support_)
+      return static_cast<int>(k);
+  }
+  return -1;
+}
+
+double OpenBoundaries::prescribed_inflow_rate(double t) const {
+  double q = 0.0;
+  for (const Zone& z : zones_)
+    if (z.spec.type == OpenBoundaryType::Inflow) q += z.spec.velocity.at(t) * z.area;
+  return q;
+}
+
+void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) const {
+  const std::size_t n = P.size();
+  const double dx3 = dx_ * dx_ * dx_;
+  // Inflow pressure: zero gradient along the axis. The volume-weighted mean pressure of the fluid in a slab
+  // one kernel support deep inside the disc, applied at the slab's centroid, plus the hydrostatic difference.
+  struct Slab {
+    double vol = 0.0, pv = 0.0;
+    Vec3 xv = Vec3::Zero();
+  };
+  std::vector<Slab> slab(zones_.size());
+  std::vector<double> outlet_p(zones_.size(), 0.0);
+  for (std::size_t k = 0; k < zones_.size(); ++k) {
+    const Zone& z = zones_[k];
+    if (z.spec.type == OpenBoundaryType::Outflow) {
+      outlet_p[k] = z.spec.pressure.at(t);
+      continue;
+    }
+    slab[k] = parallel_reduce(
+        n, Slab{},
+        [&](std::size_t i) {
+          if (P.kind[i] != Kind::Fluid || z.radial(P.x[i]) >= z.spec.radius) return Slab{};
+          const double a = z.axial(P.x[i]);
+          if (a < 0.0 || a >= support_) return Slab{};
+          const double vol = P.m[i] / P.rho[i];
+          return Slab{vol, vol * P.p[i], vol * P.x[i]};
+        },
+        [](const Slab& a, const Slab& b) {
+          return Slab{a.vol + b.vol, a.pv + b.pv, a.xv + b.xv};
+        });
+  }
+  parallel_for(n, [&](std::size_t i) {
+    if (P.kind[i] != Kind::Inflow && P.kind[i] != Kind::Outflow) return;
+    const int k = zone_of(P.x[i], P.kind[i]);
+    if (k < 0) return;
+    const Zone& z = zones_[k];
+    const FluidParams& fp = fluid_[P.material[i]];
+    double p = 0.0;
+    if (z.spec.type == OpenBoundaryType::Outflow) {
+      p = outlet_p[k] + fp.rho0 * g.dot(P.x[i] - z.spec.point);
+    } else if (slab[k].vol > 0.0) {
+      p = slab[k].pv / slab[k].vol + fp.rho0 * g.dot(P.x[i] - slab[k].xv / slab[k].vol);
+    } else {
+      p = fp.p_background;  // no fluid at the inlet yet
+    }
+    P.rho[i] = fp.density(p);
+    P.p[i] = fp.pressure(P.rho[i]);  // density() clamps far-negative pressures: keep the pair consistent
+    // Inflow particles sit on the lattice, one per dx^3: their mass follows their density, so that
+    // m / rho = dx^3 and the fluid they become has the density its spacing says. (With m = rho0 dx^3 under
+    // pressure, each entering particle would claim less volume than it fills, the fluid's density would drift
+    // above its particle number density, and the column would push out more than comes in.) The volume flow
+    // into the domain is then exactly V A, the mass flow rho V A.
+    if (P.kind[i] == Kind::Inflow) P.m[i] = P.rho[i] * dx3;
+  });
+}
+
+bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicSpline& K, const Vec3& gravity,
+                            double t_new, double dt) {
+  if (zones_.empty()) return false;
+  const std::size_t n = P.size();
+
+  // Outflow velocity, zero gradient along the axis: in order of increasing distance from the disc, each
+  // outflow particle takes the Shepard average of its fluid neighbours and of the outflow neighbours nearer
+  // the disc (already updated), so the fluid's velocity at the disc carries through the whole buffer; kept
+  // as it is where no such neighbour is near. Serial, in a fixed order (distance, then index): a few layers
+  // of particles only.
+  const auto& idx = nb.index();
+  struct Item {
+    double axial;
+    uint32_t i;
+    int zone;
+    bool operator<(const Item& o) const { return axial < o.axial || (axial == o.axial && i < o.i); }
+  };
+  std::vector<Item> order;
+  for (std::size_t i = 0; i < n; ++i)
+    if (P.kind[i] == Kind::Outflow)
+      if (const int k = zone_of(P.x[i], Kind::Outflow); k >= 0)
+        order.push_back({zones_[k].axial(P.x[i]), static_cast<uint32_t>(i), k});
+  std::sort(order.begin(), order.end());
+  std::vector<int32_t> rank(order.empty() ? 0 : n, -1);
+  for (std::size_t r = 0; r < order.size(); ++r) rank[order[r].i] = static_cast<int32_t>(r);
+  for (std::size_t r = 0; r < order.size(); ++r) {
+    const uint32_t i = order[r].i;
+    double sw = 0.0;
+    Vec3 sv = Vec3::Zero();
+    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
+      const uint32_t j = idx[k];
+      if (P.kind[j] != Kind::Fluid && !(P.kind[j] == Kind::Outflow && rank[j] >= 0 && rank[j] < rank[i]))
+        continue;
+      const double W = K.W((P.x[i] - P.x[j]).norm()) * P.m[j] / P.rho[j];
+      sw += W;
+      sv += W * P.v[j];
+    }
+    // Only the normal component: the flow leaves along the outlet's axis, and buffer particles, which feel no
+    // wall, must not drift out of the buffer sideways.
+    const Vec3& nrm = zones_[order[r].zone].spec.normal;
+    if (sw > 0.0) P.v[i] = (sv.dot(nrm) / sw) * nrm;
+  }
+
+  // Buffers move: inflow with the prescribed velocity at t_new, outflow with its own (symplectic Euler as the
+  // fluid: x(t + dt) = x + dt v(t + dt)).
+  std::vector<uint8_t> action(n, kNone);
+  std::vector<int> zone(n, -1);  // inflow particles: their zone
+  parallel_for(n, [&](std::size_t i) {
+    const Kind kind = P.kind[i];
+    if (kind == Kind::Inflow) {
+      const int k = zone_of(P.x[i], Kind::Inflow);
+      zone[i] = k;
+      if (k < 0) {  // cannot happen: buffer particles move along their column
+        action[i] = kInflowToFluid;
+        return;
+      }
+      const Zone& z = zones_[k];
+      P.v[i] = z.inflow_speed(P.x[i], t_new) * z.spec.normal;
+      P.v_wall[i] = P.v[i];
+      P.a[i] = Vec3::Zero();
+      P.x[i] += dt * P.v[i];
+      if (z.axial(P.x[i]) >= 0.0) action[i] = kInflowToFluid;
+    } else if (kind == Kind::Outflow) {
+      P.v_wall[i] = P.v[i];
+      P.a[i] = Vec3::Zero();
+      P.x[i] += dt * P.v[i];
+      const int k = zone_of(P.x[i], Kind::Outflow);
+      zone[i] = k;
+      if (k < 0) {
+        action[i] = kRemove;  // left its buffer sideways or beyond the far face
+        return;
+      }
+      const double a = zones_[k].axial(P.x[i]);
+      if (a > zones_[k].depth)
+        action[i] = kRemove;
+      else if (a < 0.0)
+        action[i] = kOutflowToFluid;
+    } else if (kind == Kind::Fluid) {
+      if (const int k = zone_of(P.x[i], Kind::Outflow);
+          k >= 0 && zones_[k].axial(P.x[i]) >= 0.0 && zones_[k].radial(P.x[i]) <= zones_[k].spec.radius)
+        action[i] = kFluidToOutflow;
+      // Fluid pushed back into an inflow buffer (a closed or slow inlet with the column sloshing) is removed
+      // only once it is more than a spacing deep, past the buffer's first layer: small back-and-forth motion
+      // across the disc must not drain the column.
+      else if (const int m = zone_of(P.x[i], Kind::Inflow);
+               m >= 0 && zones_[m].axial(P.x[i]) < -dx_ && zones_[m].radial(P.x[i]) < zones_[m].spec.radius)
+        action[i] = kRemoveBackflow;
+    }
+  });
+
+  // One serial pass in index order: the sums, the new particles' order and ids do not depend on threads.
+  std::size_t removed = 0, created = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    switch (action[i]) {
+      case kNone:
+        break;
+      case kInflowToFluid:
+      case kOutflowToFluid: {
+        P.kind[i] = Kind::Fluid;
+        state_.volume_in += P.m[i] / P.rho[i];
+        state_.mass_in += P.m[i];
+        const int k = zone[i];
+        if (k < 0) break;
+        if (state_.next_id == std::numeric_limits<uint32_t>::max())
+          throw InstabilityError("open boundaries: particle ids exhausted");
+        // The new buffer particle, `layers` spacings behind along the flow: behind the inlet disc, or at the
+        // outlet buffer's far face when fluid flows back in through an outlet (the buffer stays full; without
+        // this, every back-and-forth swing would lose the particles that passed the far face).
+        const Zone& z = zones_[k];
+        const std::size_t j = P.size();
+        P.resize(j + 1);
+        const bool inflow = action[i] == kInflowToFluid;
+        P.x[j] = P.x[i] + (inflow ? -z.depth : z.depth) * z.spec.normal;
+        P.x0[j] = P.x[j];
+        P.kind[j] = inflow ? Kind::Inflow : Kind::Outflow;
+        P.v[j] = P.v[i];
+        P.v_wall[j] = P.v[i];
+        P.rho[j] = P.rho[i];
+        P.p[j] = P.p[i];
+        P.m[j] = P.m[i];
+        P.body[j] = P.body[i];
+        P.material[j] = P.material[i];
+        P.id[j] = state_.next_id++;
+        ++created;
+        break;
+      }
+      case kFluidToOutflow:
+        P.kind[i] = Kind::Outflow;
+        P.a[i] = Vec3::Zero();
+        state_.volume_out += P.m[i] / P.rho[i];
+        state_.mass_out += P.m[i];
+        break;
+      case kRemove:
+        ++removed;
+        break;
+      case kRemoveBackflow:
+        state_.volume_out += P.m[i] / P.rho[i];
+        state_.mass_out += P.m[i];
+        ++removed;
+        break;
+    }
+  }
+  state_.created += created;
+  state_.removed += removed;
+  if (removed > 0) {
+    std::vector<uint32_t> keep;
+    keep.reserve(P.size() - removed);
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (i >= n || (action[i] != kRemove && action[i] != kRemoveBackflow))
+        keep.push_back(static_cast<uint32_t>(i));
+    P.permute(keep);
+  }
+  impose(P, gravity, t_new);
+  return created > 0 || removed > 0;
+}
+
+}  // namespace aortasph
