@@ -1,11 +1,13 @@
 #include "scene_loader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
 
+#include "aortic_root.hpp"
 #include "errors.hpp"
 
 namespace aortasph {
@@ -175,7 +177,7 @@ class Loader {
     Scene s;
     Obj top(root, "",
             {"name", "description", "domain", "resolution", "time", "gravity", "materials", "contact",
-             "bodies", "open_boundaries", "probes", "render"},
+             "aortic_root", "bodies", "open_boundaries", "probes", "render"},
             allowed);
     s.name = top.string("name");
     if (s.name.empty() || s.name.find('/') != std::string::npos || s.name == "." || s.name == "..")
@@ -217,6 +219,19 @@ class Loader {
     s.contact.shear = con.non_negative("shear", 0.0);
     s.contact.friction = con.non_negative("friction", 0.5);
 
+    // Geometry shared by the aortic_root shapes (each shape's own keys override it).
+    if (top.has("aortic_root")) {
+      Obj r(top.raw("aortic_root"), "aortic_root", root_keys(), allowed);
+      AorticRootParams p;
+      root_params(r, p, true);
+      if (const auto e = check_aortic_root(p, s.spacing))
+        fail(e->param == "spacing" ? "resolution.spacing" : r.path(e->param), e->message);
+      shared_root_ = p;
+      shared_root_keys_.clear();
+      for (auto it = top.raw("aortic_root").begin(); it != top.raw("aortic_root").end(); ++it)
+        shared_root_keys_.insert(it.key());
+    }
+
     json& bodies = top.raw("bodies");
     if (!bodies.is_array() || bodies.empty()) fail("bodies", "expected a non-empty list of bodies");
     for (std::size_t b = 0; b < bodies.size(); ++b)
@@ -253,6 +268,71 @@ class Loader {
   }
 
  private:
+  std::optional<AorticRootParams> shared_root_;
+  std::set<std::string> shared_root_keys_;
+
+  static std::vector<std::string> root_keys() {
+    return {"base",           "annulus_radius", "commissure_radius", "commissure_height", "sinus_radius",
+            "stj_height",     "aorta_radius",   "lvot_length",       "aorta_length",      "leaflet_free_edge",
+            "leaflet_height", "leaflet_layers", "wall_layers",       "commissure_angles", "sinuses"};
+  }
+
+  // Reads the aortic_root parameters that o holds over p; with fill, every parameter, defaults written into
+  // the JSON (stj_height and aorta_radius excepted: they follow commissure_height and commissure_radius).
+  static void root_params(Obj& o, AorticRootParams& p, bool fill) {
+    auto length = [&](const char* key, double& v) {
+      if (fill || o.has(key)) v = o.positive(key, v);
+    };
+    if (fill || o.has("base")) p.base = o.vec3("base", p.base);
+    length("annulus_radius", p.annulus_radius);
+    length("commissure_radius", p.commissure_radius);
+    length("commissure_height", p.commissure_height);
+    length("sinus_radius", p.sinus_radius);
+    if (o.has("stj_height")) p.stj_height = o.positive("stj_height");
+    if (o.has("aorta_radius")) p.aorta_radius = o.positive("aorta_radius");
+    length("lvot_length", p.lvot_length);
+    length("aorta_length", p.aorta_length);
+    length("leaflet_free_edge", p.leaflet_free_edge);
+    length("leaflet_height", p.leaflet_height);
+    if (fill || o.has("leaflet_layers"))
+      p.leaflet_layers = o.integer("leaflet_layers", p.leaflet_layers, 1, 10);
+    if (fill || o.has("wall_layers")) p.wall_layers = o.integer("wall_layers", p.wall_layers, 1, 20);
+    if (fill || o.has("commissure_angles")) {
+      const auto& a = p.commissure_angles;
+      const Vec3 v = o.vec3("commissure_angles", Vec3(a[0], a[1], a[2]));
+      p.commissure_angles = {v.x(), v.y(), v.z()};
+    }
+    if (fill || o.has("sinuses")) p.sinuses = o.boolean("sinuses", p.sinuses);
+  }
+
+  Shape aortic_root_shape(json& j, const std::string& path, double dx) {
+    std::vector<std::string> keys = root_keys();
+    keys.insert(keys.end(), {"part", "index"});
+    Obj o(j, path, keys, allowed);
+    Shape sh;
+    sh.kind = ShapeKind::AorticRoot;
+    const std::string part = o.choice("part", {"wall", "blood", "leaflet"});
+    sh.aortic_part = part == "wall"    ? AorticPart::Wall
+                     : part == "blood" ? AorticPart::Blood
+                                       : AorticPart::Leaflet;
+    if (sh.aortic_part == AorticPart::Leaflet)
+      sh.aortic_index = o.integer("index", std::nullopt, 0, 2);
+    else if (o.has("index"))
+      fail(o.path("index"), "only leaflets have an index");
+    // Shared geometry first, then this shape's own keys (all of them, defaults filled, when nothing is
+    // shared).
+    sh.aortic = shared_root_.value_or(AorticRootParams{});
+    root_params(o, sh.aortic, !shared_root_);
+    if (const auto e = check_aortic_root(sh.aortic, dx)) {
+      const std::string at = e->param == "spacing" ? "resolution.spacing"
+                             : o.has(e->param) || !shared_root_keys_.count(e->param)
+                                 ? o.path(e->param)
+                                 : "aortic_root." + e->param;
+      fail(at, e->message);
+    }
+    return sh;
+  }
+
   void materials(json& j, Scene& s) {
     if (!j.is_object() || j.empty()) fail("materials", "expected an object of named materials");
     for (auto it = j.begin(); it != j.end(); ++it) {
@@ -336,6 +416,16 @@ class Loader {
     if (b.name.empty()) fail(o.path("name"), "must not be empty");
     b.material = material_index(s, o.string("material"), o.path("material"));
     b.shape = shape(o.raw("shape"), o.path("shape"), s.spacing);
+    if (b.shape.kind == ShapeKind::AorticRoot) {
+      const MaterialType t = s.materials[b.material].type;
+      const AorticPart part = b.shape.aortic_part;
+      if (part == AorticPart::Wall && t != MaterialType::Wall)
+        fail(o.path("material"), "the aortic root's wall needs a wall material");
+      if (part == AorticPart::Blood && t != MaterialType::Fluid)
+        fail(o.path("material"), "the aortic root's blood needs a fluid material");
+      if (part == AorticPart::Leaflet && t != MaterialType::Elastic && t != MaterialType::Wall)
+        fail(o.path("material"), "an aortic leaflet needs an elastic (or, held still, a wall) material");
+    }
     b.translate = o.vec3("translate", Vec3::Zero());
     if (o.has("rotate")) {
       Obj r(o.raw("rotate"), o.path("rotate"), {"axis", "degrees"}, allowed);
@@ -370,8 +460,9 @@ class Loader {
                                                    "tube", "aortic_root", "mesh"};
     Obj o(j, path, kinds, allowed);
     if (j.size() != 1)
-      fail(path, "expected exactly one shape (one of box, sphere, cylinder, container, tube), got " +
-                     std::to_string(j.size()));
+      fail(path,
+           "expected exactly one shape (one of box, sphere, cylinder, container, tube, aortic_root), got " +
+               std::to_string(j.size()));
     const std::string kind = j.begin().key();
     Shape sh;
     const std::string p = o.path(kind);
@@ -408,14 +499,20 @@ class Loader {
           fail(index(b.path("open"), k),
                "unknown face '" + sh.open[k] + "' (expected +x, -x, +y, -y, +z or -z)");
       }
+    } else if (kind == "aortic_root") {
+      sh = aortic_root_shape(o.raw(kind), p, dx);
     } else {
       fail(p, "shape '" + kind + "' is not supported yet");
     }
     // A lattice of more than about 200 million points would exhaust memory long before it ran.
     Vec3 extent = Vec3::Zero();
-    if (sh.kind == ShapeKind::Box || sh.kind == ShapeKind::Container)
+    if (sh.kind == ShapeKind::Box || sh.kind == ShapeKind::Container) {
       extent = sh.box.max - sh.box.min + Vec3::Constant(2 * sh.layers * dx);
-    else
+    } else if (sh.kind == ShapeKind::AorticRoot) {
+      const AorticRootParams& a = sh.aortic;
+      const double r = std::max({a.annulus_radius, a.sinus_radius, a.aorta()}) + a.wall_layers * dx;
+      extent = Vec3(2 * r, a.lvot_length + a.stj() + a.aorta_length, 2 * r);
+    } else
       extent = Vec3::Constant(2 * (sh.radius + sh.layers * dx) + sh.length);
     const double cells = (extent / dx).array().ceil().prod();
     if (cells > 2e8)

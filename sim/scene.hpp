@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -45,6 +46,33 @@ struct Material {
 
 enum class ShapeKind { Box, Sphere, Cylinder, Container, Tube, AorticRoot, Mesh };
 
+// Parametric aortic root and valve (sim/aortic_root.hpp; docs/scenes.md). Lengths in metres, angles in
+// degrees. The root's axis is +y through `base` (the centre of the annulus disc); blood flows towards +y.
+// Defaults: Labrosse et al. 2006, J. Biomech. 39:2665 (annulus, commissures, leaflet free edge and height);
+// sinus radius 1.4 x annulus radius (see sim/aortic_root.hpp for the source).
+struct AorticRootParams {
+  Vec3 base = Vec3::Zero();
+  double annulus_radius = 0.013;      // basal ring: lumen radius at the annulus plane and of the LVOT below
+  double commissure_radius = 0.012;   // lumen radius at the commissures (and at the sinotubular junction)
+  double commissure_height = 0.0168;  // above the annulus plane
+  double sinus_radius = 0.0182;       // largest lumen radius, mid-sinus
+  double stj_height = 0.0;            // sinotubular junction above the annulus; 0: commissure_height
+  double aorta_radius = 0.0;          // ascending aorta; 0: commissure_radius
+  double lvot_length = 0.012;         // left-ventricular outflow tube below the annulus plane
+  double aorta_length = 0.03;         // ascending aorta above the sinotubular junction
+  double leaflet_free_edge = 0.030;   // commissure -> centre -> next commissure
+  double leaflet_height = 0.017;      // annulus nadir -> centre, along the leaflet's mid-line
+  int leaflet_layers = 3;             // particle layers through the leaflet thickness (thickness = layers dx)
+  int wall_layers = 3;                // fixed particle layers outside the lumen surface
+  std::array<double, 3> commissure_angles = {0.0, 120.0, 240.0};  // about +y (right hand), 0 = +x
+  bool sinuses = true;                                            // false: no sinus bulges (a graft)
+
+  double stj() const { return stj_height > 0.0 ? stj_height : commissure_height; }
+  double aorta() const { return aorta_radius > 0.0 ? aorta_radius : commissure_radius; }
+};
+
+enum class AorticPart { Wall, Blood, Leaflet };
+
 struct Shape {
   ShapeKind kind = ShapeKind::Box;
   Box box;                        // box, container (inner box)
@@ -57,6 +85,9 @@ struct Shape {
   std::vector<std::string> open;  // container: faces left out, "+x","-x","+y","-y","+z","-z"; tube: "+", "-"
                                   // ends capped unless open (tube ends are open by default)
   std::string mesh_file;          // mesh
+  AorticRootParams aortic;        // aortic_root: the root's geometry
+  AorticPart aortic_part = AorticPart::Wall;  // aortic_root: which part this body is
+  int aortic_index = 0;                       // aortic_root leaflets: 0, 1, 2
 };
 
 enum class RenderMode { Particles, Surface, Hidden };

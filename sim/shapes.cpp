@@ -5,6 +5,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "aortic_root.hpp"
+
 namespace aortasph {
 
 namespace {
@@ -95,6 +97,8 @@ Vec3 shape_center(const Shape& s) {
     case ShapeKind::Cylinder:
     case ShapeKind::Tube:
       return s.base + 0.5 * s.length * s.axis.normalized();
+    case ShapeKind::AorticRoot:
+      return s.aortic.base;  // the same for every part of one root, so they rotate together
     default:
       return Vec3::Zero();
   }
@@ -187,6 +191,8 @@ ShapeSample sample_body(const Body& body, double dx) {
       break;
     }
     case ShapeKind::AorticRoot:
+      out = sample_aortic_root(s.aortic, s.aortic_part, s.aortic_index, dx);
+      break;
     case ShapeKind::Mesh:
       break;  // refused by the scene loader until implemented
   }

@@ -2,6 +2,7 @@
 // the surface meshes that the renderer draws for walls.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "scene.hpp"
@@ -12,8 +13,9 @@ namespace aortasph {
 struct ShapeSample {
   std::vector<Vec3> points;  // particle centres, world coordinates, lexicographic lattice order
   SurfaceMesh mesh;          // surface for rendering, world coordinates
-  std::vector<uint8_t>
-      clamped;  // empty, or per point: 1 = held in place by the shape itself (elastic bodies)
+  // Empty, or one flag per point: 1 = clamped by the shape itself (the aortic leaflets' rows along their
+  // attachment to the wall). Elastic solvers treat these like the body's `fixed` region.
+  std::vector<uint8_t> clamped;
 };
 
 // Lattice convention: a box [min, max] holds the centres min + (i + 1/2) dx, so the particles' cubes tile it

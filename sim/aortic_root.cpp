@@ -1,0 +1,551 @@
+#include "aortic_root.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <sstream>
+#include <unordered_map>
+
+namespace aortasph {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+constexpr double kDropExponent = 1.5;  // see leaflet_surface
+
+double deg(double d) {
+  return d * kPi / 180.0;
+}
+
+std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+double smoothstep(double t) {
+  t = std::clamp(t, 0.0, 1.0);
+  return t * t * (3.0 - 2.0 * t);
+}
+
+// Angle in [0, 2 pi).
+double wrap(double a) {
+  a = std::fmod(a, kTwoPi);
+  return a < 0.0 ? a + kTwoPi : a;
+}
+
+// Leaflet sheet: rows this far (in dx) from the attachment line, and the margins that keep bodies apart.
+constexpr double kFirstRow = 0.5;       // first row's arc length from the attachment line
+constexpr double kSectorMargin = 0.45;  // leaflet particles at least this far from a neighbour's sector
+constexpr double kWallMargin = 0.4;     // ... and this far inside the lumen surface
+constexpr double kClampDepth = 1.75;    // clamped: within this distance of the lumen surface (about 2 rows)
+constexpr double kLayerMin = 0.6;       // leaflet particles of one leaflet at least this far apart
+constexpr double kBloodGap = 0.9;       // blood lattice points at least this far from leaflet particles
+constexpr int kMeridianSamples = 100;   // arc-length table along a leaflet meridian
+
+// Projected distance of a point at polar angle offset a inside a sector of width w, radius r, to the
+// sector's two bounding half-planes (rays in projection).
+double sector_distance(double r, double a, double w) {
+  auto to_ray = [&](double t) { return t <= kPi / 2 ? r * std::sin(t) : r; };
+  return std::min(to_ray(a), to_ray(w - a));
+}
+
+}  // namespace
+
+AorticRoot::AorticRoot(const AorticRootParams& p) : p_(p) {
+  for (int k = 0; k < 3; ++k) phi_[k] = deg(p_.commissure_angles[k]);
+  dphi_[0] = phi_[1] - phi_[0];
+  dphi_[1] = phi_[2] - phi_[1];
+  dphi_[2] = phi_[0] + kTwoPi - phi_[2];
+  const double half_edge = 0.5 * p_.leaflet_free_edge;
+  y_c_ = p_.commissure_height -
+         std::sqrt(std::max(0.0, half_edge * half_edge - p_.commissure_radius * p_.commissure_radius));
+  bulge_ = p_.sinuses ? p_.sinus_radius - cone_radius(0.5 * p_.stj()) : 0.0;
+  // Belly sag S: the mid-line's length grows monotonically with S; bisection to leaflet_height.
+  double lo = 0.0, hi = 4.0 * p_.annulus_radius;
+  if (midline_length(0.0) >= p_.leaflet_height) {
+    hi = 0.0;
+  } else if (midline_length(hi) > p_.leaflet_height) {
+    for (int it = 0; it < 80; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (midline_length(mid) < p_.leaflet_height ? lo : hi) = mid;
+    }
+  }
+  sag_ = hi;
+}
+
+double AorticRoot::cone_radius(double y) const {
+  const double ra = p_.annulus_radius, rc = p_.commissure_radius;
+  if (y <= 0.0) return ra;
+  if (y < p_.commissure_height) return ra + (rc - ra) * y / p_.commissure_height;
+  if (y <= p_.stj()) return rc;
+  return rc + (p_.aorta() - rc) * smoothstep((y - p_.stj()) / rc);
+}
+
+int AorticRoot::sector_of(double theta, double& s) const {
+  for (int k = 0; k < 3; ++k) {
+    const double d = wrap(theta - phi_[k]);
+    if (d < dphi_[k]) {
+      s = d / dphi_[k];
+      return k;
+    }
+  }
+  s = 0.0;  // only reached through rounding at a sector's end
+  return 0;
+}
+
+double AorticRoot::attachment_height(double s) const {
+  const double c = std::cos(kPi * s);
+  return p_.commissure_height * c * c;
+}
+
+double AorticRoot::bump(double s, double y) const {
+  if (bulge_ <= 0.0) return 0.0;
+  const double ya = attachment_height(s), top = p_.stj();
+  if (y <= ya || y >= top) return 0.0;
+  const double w = std::sin(kPi * s);
+  return bulge_ * w * w * std::sin(kPi * (y - ya) / (top - ya));
+}
+
+double AorticRoot::lumen_radius(double y, double theta) const {
+  double s = 0.0;
+  sector_of(theta, s);
+  return cone_radius(y) + bump(s, y);
+}
+
+double AorticRoot::normal_scale(double y, double theta) const {
+  const double h = 1e-7, ht = 1e-6, R = lumen_radius(y, theta);
+  const double r_y = (lumen_radius(y + h, theta) - lumen_radius(y - h, theta)) / (2 * h);
+  const double r_t = (lumen_radius(y, theta + ht) - lumen_radius(y, theta - ht)) / (2 * ht) / R;
+  return std::sqrt(1.0 + r_y * r_y + r_t * r_t);
+}
+
+Vec3 AorticRoot::leaflet_surface(int k, double rho, double s, double inset) const {
+  // In projection: from the apex (on the bisector, `inset` from both coaptation planes) to the attachment
+  // point, whose angle runs over the sector less `inset` at the commissure radius at either end, so the
+  // free edges (s = 0, 1) run parallel to the coaptation planes at distance `inset`.
+  const double half = std::min(0.5 * dphi_[k], kPi / 2);
+  const double r_apex = inset / std::sin(half), t_mid = phi_[k] + 0.5 * dphi_[k];
+  const double delta = std::asin(std::min(1.0, inset / p_.commissure_radius));
+  const double theta = phi_[k] + delta + s * (dphi_[k] - 2 * delta);
+  const double ya = attachment_height(s);
+  const double ra = cone_radius(ya);
+  const double x = (1 - rho) * r_apex * std::cos(t_mid) + rho * ra * std::cos(theta);
+  const double z = -(1 - rho) * r_apex * std::sin(t_mid) - rho * ra * std::sin(theta);
+  // Free-edge line plus the attachment's drop below the commissures, fading towards the centre as rho^1.5,
+  // less the belly's sag. The sag's profile across the leaflet, 1 - cos^4(pi s), is level at the free edges
+  // and flat mid-leaflet, so the belly is a rounded trough rather than a fold along the bisector.
+  const double c2 = std::cos(kPi * s) * std::cos(kPi * s);
+  const double edge = y_c_ + (p_.commissure_height - y_c_) * rho;
+  const double y = edge + (ya - p_.commissure_height) * std::pow(rho, kDropExponent) -
+                   sag_ * std::sin(kPi * rho) * (1.0 - c2 * c2);
+  return Vec3(x, y, z);
+}
+
+double AorticRoot::midline_length(double sag) const {
+  // Mid-line s = 1/2 (without the dx/2 inset): r = rho annulus_radius, y as in leaflet_surface.
+  const int n = 2000;
+  double len = 0.0, r0 = 0.0, y0 = y_c_;
+  for (int i = 1; i <= n; ++i) {
+    const double rho = static_cast<double>(i) / n;
+    const double r = rho * p_.annulus_radius;
+    const double y = y_c_ + (p_.commissure_height - y_c_) * rho -
+                     p_.commissure_height * std::pow(rho, kDropExponent) - sag * std::sin(kPi * rho);
+    len += std::hypot(r - r0, y - y0);
+    r0 = r;
+    y0 = y;
+  }
+  return len;
+}
+
+double AorticRoot::leaflet_lowest() const {
+  double low = y_c_;
+  for (int i = 0; i <= 200; ++i)
+    for (int j = 0; j <= 100; ++j) low = std::min(low, leaflet_surface(0, i / 200.0, j / 100.0).y());
+  return low;
+}
+
+double AorticRoot::orifice_radius() const {
+  return std::min(p_.annulus_radius, p_.commissure_radius);
+}
+
+double AorticRoot::annulus_area() const {
+  return kPi * p_.annulus_radius * p_.annulus_radius;
+}
+
+Vec3 AorticRoot::to_world(double r, double theta, double y) const {
+  return p_.base + Vec3(r * std::cos(theta), y, -r * std::sin(theta));
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Wall
+
+std::vector<Vec3> AorticRoot::wall_points(double dx, SurfaceMesh* mesh) const {
+  const double y_bot = -p_.lvot_length, y_top = p_.stj() + p_.aorta_length;
+  const double hy = 1e-4 * dx;
+  auto r_y = [&](double y, double th) {
+    return (lumen_radius(y + hy, th) - lumen_radius(y - hy, th)) / (2 * hy);
+  };
+  const int nt = 720;
+
+  // Ring levels: dx apart along the wall where it is steepest at that height.
+  std::vector<double> levels;
+  for (double y = y_bot + 0.5 * dx; y <= y_top - 0.5 * dx + 1e-9 * dx;) {
+    levels.push_back(y);
+    double slope = 0.0;
+    for (int m = 0; m < nt; m += 4) slope = std::max(slope, std::abs(r_y(y, phi_[0] + kTwoPi * m / nt)));
+    y += dx / std::sqrt(1.0 + slope * slope);
+  }
+
+  std::vector<Vec3> out;
+  std::vector<double> xs(nt + 1), zs(nt + 1), len(nt + 1);
+  for (std::size_t q = 0; q < levels.size(); ++q) {
+    const double y = levels[q];
+    for (int j = 0; j < p_.wall_layers; ++j) {
+      // Layer j's closed curve r(theta), offset so that layers are dx apart along the wall's normal.
+      for (int m = 0; m <= nt; ++m) {
+        const double th = phi_[0] + kTwoPi * m / nt;
+        const double r = lumen_radius(y, th) + (j + 0.5) * dx * normal_scale(y, th);
+        xs[m] = r * std::cos(th);
+        zs[m] = -r * std::sin(th);
+        len[m] = m == 0 ? 0.0 : len[m - 1] + std::hypot(xs[m] - xs[m - 1], zs[m] - zs[m - 1]);
+      }
+      const double perimeter = len[nt];
+      const int n = std::max(8, static_cast<int>(std::lround(perimeter / dx)));
+      // Neighbouring rings and layers staggered by half a spacing.
+      const double shift = 0.5 * static_cast<double>((q + j) % 2);
+      int m = 0;
+      for (int i = 0; i < n; ++i) {
+        const double a = (i + shift) * perimeter / n;
+        while (m < nt - 1 && len[m + 1] < a) ++m;
+        const double t = (a - len[m]) / std::max(len[m + 1] - len[m], 1e-300);
+        out.push_back(p_.base + Vec3(xs[m] + t * (xs[m + 1] - xs[m]), y, zs[m] + t * (zs[m + 1] - zs[m])));
+      }
+    }
+  }
+
+  if (mesh) {
+    // Lumen surface: a grid over (y, theta), closed around the axis, open at both ends. Triangles are
+    // counter-clockwise seen from the lumen (normals point to the axis, as for a tube's wall).
+    std::vector<double> ys;
+    ys.push_back(y_bot);
+    for (double y : levels) ys.push_back(y);
+    ys.push_back(y_top);
+    const int per_sector = 48, nc = 3 * per_sector;
+    std::vector<double> th;
+    for (int k = 0; k < 3; ++k)
+      for (int m = 0; m < per_sector; ++m) th.push_back(phi_[k] + dphi_[k] * m / per_sector);
+    for (double y : ys)
+      for (double t : th) {
+        const Vec3 v = to_world(lumen_radius(y, t), t, y);
+        mesh->vertices.push_back(
+            {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())});
+      }
+    for (std::size_t a = 0; a + 1 < ys.size(); ++a)
+      for (int c = 0; c < nc; ++c) {
+        const auto a0 = static_cast<uint32_t>(a * nc + c), a1 = static_cast<uint32_t>(a * nc + (c + 1) % nc);
+        const auto b0 = a0 + nc, b1 = a1 + nc;
+        mesh->triangles.push_back({a0, b0, b1});
+        mesh->triangles.push_back({a0, b1, a1});
+      }
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Leaflets
+
+std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8_t>* clamped) const {
+  // The sheet is built on the surface inset by half a spacing from both coaptation planes, so its free edges
+  // lie dx/2 from them and the neighbouring leaflet's particles are dx away across each plane.
+  const double inset = 0.5 * dx;
+  auto surface_at = [&](double rho, double s) { return leaflet_surface(k, rho, s, inset); };
+
+  // Meridian s (s = const, from the apex at rho = 0 to the attachment at rho = 1): cumulative arc length.
+  auto meridian = [&](double s) {
+    std::vector<double> c(kMeridianSamples + 1, 0.0);
+    Vec3 prev = surface_at(0.0, s);
+    for (int m = 1; m <= kMeridianSamples; ++m) {
+      const Vec3 q = surface_at(static_cast<double>(m) / kMeridianSamples, s);
+      c[m] = c[m - 1] + (q - prev).norm();
+      prev = q;
+    }
+    return c;
+  };
+  // rho at arc length c from the apex along a meridian.
+  auto rho_at = [&](const std::vector<double>& mc, double c) {
+    const auto it = std::lower_bound(mc.begin(), mc.end(), c);
+    if (it == mc.begin()) return 0.0;
+    if (it == mc.end()) return 1.0;
+    const auto m = static_cast<int>(it - mc.begin());
+    const double t = (c - mc[m - 1]) / std::max(mc[m] - mc[m - 1], 1e-300);
+    return (m - 1 + t) / kMeridianSamples;
+  };
+
+  // Number of rows: the mean meridian length over all three leaflets, in dx (the same for all three, so
+  // their rows meet pairwise along the coaptation lines, where the meridians are alike).
+  double mean_len = 0.0;
+  const int ns = 32;
+  for (int l = 0; l < 3; ++l)
+    for (int i = 0; i < ns; ++i) {
+      const double s = (i + 0.5) / ns;
+      Vec3 prev = leaflet_surface(l, 0.0, s, inset);
+      for (int m = 1; m <= kMeridianSamples; ++m) {
+        const Vec3 q = leaflet_surface(l, static_cast<double>(m) / kMeridianSamples, s, inset);
+        mean_len += (q - prev).norm() / (3 * ns);
+        prev = q;
+      }
+    }
+  const int rows = std::max(2, static_cast<int>(std::lround((mean_len - kFirstRow * dx) / dx)) + 1);
+
+  // Row i on meridian s: arc length kFirstRow dx + i (L - kFirstRow dx) / (rows - 1) from the attachment;
+  // the last row is the apex.
+  auto row_rho = [&](int i, double s) {
+    const std::vector<double> mc = meridian(s);
+    const double L = mc.back();
+    const double from_att = kFirstRow * dx + i * (L - kFirstRow * dx) / (rows - 1);
+    return rho_at(mc, L - from_att);
+  };
+
+  // Mid-surface points with their normals, row by row, equally spaced by arc length along each row.
+  std::vector<Vec3> mids, normals;
+  const int arc_samples = 128;
+  for (int i = 0; i < rows; ++i) {
+    std::vector<double> ss(arc_samples + 1), cl(arc_samples + 1);
+    Vec3 prev = Vec3::Zero();
+    for (int a = 0; a <= arc_samples; ++a) {
+      ss[a] = static_cast<double>(a) / arc_samples;
+      const Vec3 q = surface_at(row_rho(i, ss[a]), ss[a]);
+      cl[a] = a == 0 ? 0.0 : cl[a - 1] + (q - prev).norm();
+      prev = q;
+    }
+    const double total = cl.back();
+    const int n = std::max(1, static_cast<int>(std::lround(total / dx)) + 1);
+    for (int m = 0; m < n; ++m) {
+      const double target = n == 1 ? 0.5 * total : total * m / (n - 1);
+      const auto it = std::lower_bound(cl.begin(), cl.end(), target);
+      double s = 1.0;
+      if (it == cl.begin()) {
+        s = 0.0;
+      } else if (it != cl.end()) {
+        const auto a = static_cast<int>(it - cl.begin());
+        const double t = (target - cl[a - 1]) / std::max(cl[a] - cl[a - 1], 1e-300);
+        s = ss[a - 1] + t * (ss[a] - ss[a - 1]);
+      }
+      const double rho = row_rho(i, s);
+      // Normal from the surface's tangents (at the apex, from just beside it).
+      const double rn = std::max(rho, 1e-3), e = 1e-6;
+      const Vec3 d_rho = surface_at(rn + e, s) - surface_at(rn, s);
+      const Vec3 d_s = surface_at(rn, s + e) - surface_at(rn, s - e);
+      Vec3 nrm = d_rho.cross(d_s).normalized();
+      if (nrm.y() < 0) nrm = -nrm;
+      mids.push_back(surface_at(rho, s));
+      normals.push_back(nrm);
+    }
+  }
+
+  // Layers through the thickness, centred on the surface, the mid-surface first, then outwards in pairs
+  // (ventricular side first). Where the sheet is folded tighter than its thickness, the concave side's
+  // offsets crowd: a point closer than kLayerMin dx to one already placed is left out.
+  std::vector<int> order;
+  for (int j = 0; j < p_.leaflet_layers; ++j) order.push_back(j);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return std::abs(2 * a - (p_.leaflet_layers - 1)) < std::abs(2 * b - (p_.leaflet_layers - 1));
+  });
+  std::unordered_map<int64_t, std::vector<Vec3>> placed;
+  auto key = [&](const Vec3& q, int a, int b, int c) {
+    const int64_t i = static_cast<int64_t>(std::floor(q.x() / dx)) + a + (1 << 20);
+    const int64_t j = static_cast<int64_t>(std::floor(q.y() / dx)) + b + (1 << 20);
+    const int64_t l = static_cast<int64_t>(std::floor(q.z() / dx)) + c + (1 << 20);
+    return (i << 42) | (j << 21) | l;
+  };
+  auto crowded = [&](const Vec3& q) {
+    for (int a = -1; a <= 1; ++a)
+      for (int b = -1; b <= 1; ++b)
+        for (int c = -1; c <= 1; ++c) {
+          const auto it = placed.find(key(q, a, b, c));
+          if (it == placed.end()) continue;
+          for (const Vec3& o : it->second)
+            if ((o - q).squaredNorm() < kLayerMin * kLayerMin * dx * dx) return true;
+        }
+    return false;
+  };
+  std::vector<Vec3> out;
+  if (clamped) clamped->clear();
+  for (int j : order) {
+    const double off = (j - 0.5 * (p_.leaflet_layers - 1)) * dx;
+    for (std::size_t m = 0; m < mids.size(); ++m) {
+      const Vec3 q = mids[m] + off * normals[m];
+      const double r = std::hypot(q.x(), q.z()), th = std::atan2(-q.z(), q.x());
+      double s = 0.0;
+      if (sector_of(th, s) != k) continue;
+      if (sector_distance(r, s * dphi_[k], dphi_[k]) < kSectorMargin * dx) continue;
+      const double depth = (lumen_radius(q.y(), th) - r) / normal_scale(q.y(), th);
+      if (depth < kWallMargin * dx || q.y() < -p_.lvot_length + 0.5 * dx) continue;
+      if (crowded(q)) continue;
+      placed[key(q, 0, 0, 0)].push_back(q);
+      out.push_back(p_.base + q);
+      if (clamped) clamped->push_back(depth < kClampDepth * dx ? 1 : 0);
+    }
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Blood
+
+std::vector<Vec3> AorticRoot::blood_points(double dx) const {
+  // Leaflet particles in a hash grid of cell dx, to keep the blood kBloodGap dx away from them.
+  std::unordered_map<int64_t, std::vector<Vec3>> grid;
+  auto cell = [&](const Vec3& q) {
+    const Vec3 c = ((q - p_.base) / dx).array().floor();
+    return (static_cast<int64_t>(c.x()) + (1 << 20)) * (int64_t(1) << 42) +
+           (static_cast<int64_t>(c.y()) + (1 << 20)) * (int64_t(1) << 21) +
+           (static_cast<int64_t>(c.z()) + (1 << 20));
+  };
+  double leaf_lo = 1e300, leaf_hi = -1e300;  // heights (relative to base) the leaflets span, +- dx
+  for (int k = 0; k < 3; ++k)
+    for (const Vec3& q : leaflet_points(k, dx, nullptr)) {
+      grid[cell(q)].push_back(q);
+      leaf_lo = std::min(leaf_lo, q.y() - p_.base.y() - dx);
+      leaf_hi = std::max(leaf_hi, q.y() - p_.base.y() + dx);
+    }
+  auto near_leaflet = [&](const Vec3& q) {
+    for (int a = -1; a <= 1; ++a)
+      for (int b = -1; b <= 1; ++b)
+        for (int c = -1; c <= 1; ++c) {
+          const auto it = grid.find(cell(q + dx * Vec3(a, b, c)));
+          if (it == grid.end()) continue;
+          for (const Vec3& o : it->second)
+            if ((o - q).squaredNorm() < kBloodGap * kBloodGap * dx * dx) return true;
+        }
+    return false;
+  };
+
+  const double y_bot = -p_.lvot_length, y_top = p_.stj() + p_.aorta_length;
+  const double r_max =
+      std::max({p_.annulus_radius, p_.commissure_radius, p_.aorta(), p_.sinuses ? p_.sinus_radius : 0.0}) +
+      dx;
+  const int nr = static_cast<int>(std::ceil(r_max / dx));
+  const int ny = static_cast<int>(std::lround((y_top - y_bot) / dx));
+  std::vector<Vec3> out;
+  for (int kz = -nr; kz < nr; ++kz)
+    for (int jy = 0; jy < ny; ++jy)
+      for (int ix = -nr; ix < nr; ++ix) {
+        const double x = (ix + 0.5) * dx, y = y_bot + (jy + 0.5) * dx, z = (kz + 0.5) * dx;
+        const double r = std::hypot(x, z);
+        if (r > r_max) continue;
+        const double th = std::atan2(-z, x);
+        // Normal depth <= radial depth; the slope factor only where the radial depth leaves a doubt.
+        const double radial = lumen_radius(y, th) - r;
+        if (radial < 0.5 * dx || (radial < 4 * dx && radial / normal_scale(y, th) < 0.5 * dx)) continue;
+        const Vec3 q = p_.base + Vec3(x, y, z);
+        if (y >= leaf_lo && y <= leaf_hi && near_leaflet(q)) continue;
+        out.push_back(q);
+      }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+
+std::optional<AorticRootError> check_aortic_root(const AorticRootParams& p, double dx) {
+  auto err = [](std::string param, std::string msg) {
+    return AorticRootError{std::move(param), std::move(msg)};
+  };
+  const double lengths[] = {p.annulus_radius, p.commissure_radius, p.commissure_height, p.sinus_radius,
+                            p.lvot_length,    p.aorta_length,      p.leaflet_free_edge, p.leaflet_height};
+  const char* names[] = {"annulus_radius", "commissure_radius", "commissure_height", "sinus_radius",
+                         "lvot_length",    "aorta_length",      "leaflet_free_edge", "leaflet_height"};
+  for (int i = 0; i < 8; ++i)
+    if (!(lengths[i] > 0) || !std::isfinite(lengths[i])) return err(names[i], "must be positive");
+  if (p.stj_height < 0 || p.aorta_radius < 0)
+    return err(p.stj_height < 0 ? "stj_height" : "aorta_radius", "must be positive");
+  if (p.leaflet_layers < 1) return err("leaflet_layers", "must be at least 1");
+  if (p.wall_layers < 1) return err("wall_layers", "must be at least 1");
+
+  const auto& a = p.commissure_angles;
+  for (int k = 0; k < 2; ++k)
+    if (!(a[k + 1] > a[k]))
+      return err("commissure_angles",
+                 "must increase (got " + num(a[0]) + ", " + num(a[1]) + ", " + num(a[2]) + ")");
+  const double gaps[3] = {a[1] - a[0], a[2] - a[1], a[0] + 360.0 - a[2]};
+  for (int k = 0; k < 3; ++k)
+    if (gaps[k] < 30.0)
+      return err("commissure_angles", "commissures " + std::to_string(k) + " and " +
+                                          std::to_string((k + 1) % 3) + " are " + num(gaps[k]) +
+                                          " degrees apart (at least 30)");
+
+  if (p.stj_height > 0 && p.stj_height < p.commissure_height)
+    return err("stj_height", "must not lie below commissure_height (" + num(p.commissure_height) + ")");
+  if (p.sinuses) {
+    if (p.commissure_radius >= p.sinus_radius)
+      return err("commissure_radius", "must be smaller than sinus_radius (" + num(p.sinus_radius) + ")");
+    if (p.annulus_radius >= p.sinus_radius)
+      return err("sinus_radius", "must be larger than annulus_radius (" + num(p.annulus_radius) + ")");
+  }
+  if (p.leaflet_free_edge < 2.0 * p.commissure_radius)
+    return err("leaflet_free_edge",
+               num(p.leaflet_free_edge) +
+                   " is too short to close the valve: at least 2 x commissure_radius = " +
+                   num(2.0 * p.commissure_radius));
+  const double longest = 2.0 * std::hypot(p.commissure_radius, p.commissure_height);
+  if (p.leaflet_free_edge > longest)
+    return err("leaflet_free_edge",
+               num(p.leaflet_free_edge) +
+                   " is too long: the free edges would meet below the annulus plane (at most " +
+                   num(longest) + ")");
+
+  const AorticRoot root(p);
+  const double chord = std::hypot(p.annulus_radius, root.coaptation_height());
+  if (p.leaflet_height < chord)
+    return err("leaflet_height",
+               num(p.leaflet_height) +
+                   " is too short to reach from the annulus to the coaptation point (at least " + num(chord) +
+                   ")");
+  const double low = root.leaflet_lowest();
+  if (low < -0.5 * p.annulus_radius)
+    return err("leaflet_height", num(p.leaflet_height) +
+                                     " is too long: the closed leaflet's belly would sag to " + num(low) +
+                                     " below the annulus plane (at most annulus_radius / 2)");
+
+  if (dx > p.commissure_radius / 6.0)
+    return err("spacing", "spacing " + num(dx) +
+                              " is too coarse for the aortic root (at most commissure_radius / 6 = " +
+                              num(p.commissure_radius / 6.0) + ")");
+  if (p.leaflet_layers * dx > p.commissure_radius / 4.0)
+    return err("leaflet_layers", std::to_string(p.leaflet_layers) + " layers at spacing " + num(dx) +
+                                     " make the leaflets too thick (at most commissure_radius / 4)");
+  if (low - 0.5 * p.leaflet_layers * dx < -p.lvot_length + dx)
+    return err("lvot_length", num(p.lvot_length) + " is too short: the leaflets reach down to " +
+                                  num(low - 0.5 * p.leaflet_layers * dx) + " below the annulus plane");
+  if (p.lvot_length < dx || p.aorta_length < dx)
+    return err(p.lvot_length < dx ? "lvot_length" : "aorta_length", "must be at least one particle spacing");
+  return std::nullopt;
+}
+
+ShapeSample sample_aortic_root(const AorticRootParams& p, AorticPart part, int leaflet, double dx) {
+  ShapeSample out;
+  const AorticRoot root(p);
+  switch (part) {
+    case AorticPart::Wall:
+      out.points = root.wall_points(dx, &out.mesh);
+      break;
+    case AorticPart::Blood:
+      out.points = root.blood_points(dx);
+      break;
+    case AorticPart::Leaflet:
+      out.points = root.leaflet_points(std::clamp(leaflet, 0, 2), dx, &out.clamped);
+      break;
+  }
+  return out;
+}
+
+double bending_equivalent_modulus(double real_youngs_modulus, double real_thickness, double model_thickness) {
+  const double ratio = real_thickness / model_thickness;
+  return real_youngs_modulus * ratio * ratio * ratio;
+}
+
+}  // namespace aortasph

@@ -1,0 +1,141 @@
+// Parametric aortic root with a closed trileaflet valve (issue 6): the wall (fixed particles), three leaflets
+// (separate elastic bodies, clamped along their attachment to the wall) and the blood inside.
+//
+// Geometry, in the root's frame: axis +y, annulus (basal ring) plane y = 0 through `base`; polar angle theta
+// about +y by the right-hand rule, theta = 0 along +x, so a point is base + (r cos theta, y, -r sin theta).
+// s in [0, 1] runs across one sinus / leaflet from commissure k to commissure k+1.
+//
+//  * Lumen radius R(y, theta). Below the annulus (the LV outflow tract) R = annulus_radius. Between the
+//  annulus
+//    and the commissures the root is a truncated cone Rc(y) from annulus_radius to commissure_radius,
+//    continued at commissure_radius up to the sinotubular junction (STJ) and then blended (smoothstep over
+//    one commissure radius) into the ascending aorta. Each sinus of Valsalva bulges out of this cone *above*
+//    its leaflet's attachment line and below the STJ:
+//        R = Rc(y) + A sin^2(pi s) sin(pi (y - y_att(s)) / (H_stj - y_att(s))),
+//    A chosen so that the largest radius, mid-sinus at half the STJ height, is sinus_radius. So R =
+//    commissure radius at the commissures, the sinus radius mid-sinus, and below the attachment line (the
+//    interleaflet triangles) the wall is the plain cone. With sinuses = false, A = 0 (a graft; a straight
+//    tube when the annulus, commissure and aorta radii are equal).
+//  * Attachment line of each leaflet (the crown between two commissures), on the cone:
+//        y_att(s) = commissure_height cos^2(pi s),  r = Rc(y_att(s)),
+//    at the annulus plane mid-sinus (r = annulus_radius), at the commissure height at both commissures.
+//  * Closed leaflet, rho in [0, 1] from the centre to the attachment line:
+//        (x, z) = (1 - rho) apex + rho attachment point(s),
+//        y = y_c + (commissure_height - y_c) rho + (y_att(s) - commissure_height) rho^1.5
+//            - S sin(pi rho) (1 - cos^4(pi s)).
+//    At s = 0 and s = 1 this is the free edge, a straight line from the commissure (commissure_radius,
+//    commissure_height) to the coaptation point (centre, y_c); y_c follows from the free-edge length Lf:
+//    (Lf / 2)^2 = commissure_radius^2 + (commissure_height - y_c)^2. The three leaflets meet along the three
+//    radial planes of the commissures. The attachment's drop fades towards the centre (rho^1.5) and the belly
+//    sags by S (towards the ventricle), S solved so that the mid-line (s = 1/2), nadir to centre, is
+//    leaflet_height long; the sag's profile 1 - cos^4 is level at the free edges and flat mid-leaflet. Both
+//    s-profiles have zero slope at s = 0, 1, so neighbouring leaflets meet edge to edge with parallel
+//    normals. For particles the surface is inset by dx/2 from the coaptation planes: the apex sits on the
+//    sector's bisector dx/2 from both planes, and the attachment angles run over the sector less dx/2 (at the
+//    commissure radius) at either end, so each free edge runs parallel to its plane at dx/2 and the
+//    neighbouring leaflets' particles face each other dx apart (a closed valve with a gap of one spacing).
+//  * Leaflet particles: a structured sheet. Rows run parallel to the attachment line, equally spaced by arc
+//    length along each meridian (s = const), the first row dx/2 from the attachment, the last the apex;
+//    along a row the points are equally spaced by arc length (about dx). Each point is repeated
+//    leaflet_layers times along the surface normal, centred on the surface (thickness = layers dx); where the
+//    sheet is folded tighter than its thickness, offset points closer than 0.6 dx to one already placed are
+//    left out. Points nearer than 0.45 dx to a neighbour's sector or 0.4 dx to the lumen surface are left out
+//    too, so leaflets never overlap each other or the wall (>= 0.9 dx between bodies).
+//  * Clamp: leaflet particles within 1.75 dx of the lumen surface (normal distance, see normal_scale; about
+//    two rows) are flagged clamped.
+//  * Wall: rings of particles at y levels (spaced dx, closer where the sinus wall is steep, so spacing along
+//    the wall stays <= dx), each ring wall_layers deep, layer j at R + (j + 1/2) dx (scaled by the wall's
+//    slope so the layers are dx apart along the normal); rings and layers staggered by half a spacing; ends
+//    open. The mesh is the lumen surface R(y, theta), closed around the axis, normals towards the axis.
+//  * Blood: lattice points (spacing dx, aligned with base) at least dx/2 inside the lumen surface (along its
+//    normal) and 0.9 dx from every leaflet particle, from the bottom of the LVOT to the top of the aorta.
+//
+// All parts of one root must share the body transforms (rotate, translate); they rotate about `base`.
+//
+// Defaults (sim/scene.hpp AorticRootParams): Labrosse, Beller, Robicsek & Thubrikar 2006, "Geometric modeling
+// of functional trileaflet aortic valves: development and clinical applications", J. Biomech. 39:2665-2672:
+// annulus radius 13 mm, commissure radius 12 mm, commissure height 16.8 mm, free edge 30 mm, leaflet height
+// 17 mm. Sinus radius 1.4 x annulus radius = 18.2 mm: the middle of the 1.3-1.5 band of sinus to annulus
+// ratios of pressurised human roots that issue 6 quotes (Swanson & Clark 1974, "Dimensions and geometric
+// relationships of the human aortic valve as a function of pressure", Circ. Res. 35:871-882; the paper's
+// tables were not at hand here, so the ratio is taken as quoted).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scene.hpp"
+#include "shapes.hpp"
+
+namespace aortasph {
+
+// A parameter that makes the geometry impossible, and why (the scene loader turns this into an error at the
+// parameter's JSON path).
+struct AorticRootError {
+  std::string param;
+  std::string message;
+};
+std::optional<AorticRootError> check_aortic_root(const AorticRootParams& p, double dx);
+
+// The particles (and for the wall, the lumen surface mesh) of one part, in world coordinates before the
+// body's own rotate/translate. Leaflets carry `clamped` flags. Deterministic order.
+ShapeSample sample_aortic_root(const AorticRootParams& p, AorticPart part, int leaflet, double dx);
+
+// Derived geometry, for tests, probes and scene authors.
+class AorticRoot {
+ public:
+  explicit AorticRoot(const AorticRootParams& p);
+
+  const AorticRootParams& params() const { return p_; }
+  // Lumen radius at height y above the annulus plane and polar angle theta [rad].
+  double lumen_radius(double y, double theta) const;
+  // Radial distance per unit distance along the lumen surface's normal at (y, theta): sqrt(1 + R_y^2 +
+  // (R_theta / R)^2). Radial gaps divided by it are (to first order) normal distances to the wall.
+  double normal_scale(double y, double theta) const;
+  // Radius of the plain cone (no sinus) at height y.
+  double cone_radius(double y) const;
+  // Leaflet k's sector: first commissure angle [rad] and its width [rad].
+  double sector_start(int k) const { return phi_[k]; }
+  double sector_width(int k) const { return dphi_[k]; }
+  // Sector index and fraction s in [0, 1) of a polar angle.
+  int sector_of(double theta, double& s) const;
+  double attachment_height(double s) const;
+  double coaptation_height() const { return y_c_; }  // centre of the closed valve, above the annulus
+  double belly_sag() const { return sag_; }
+  // Closed leaflet surface point (root frame, relative to base) at (rho, s) of leaflet k; with inset > 0, the
+  // surface pulled in by that distance from the two coaptation planes (see the header comment).
+  Vec3 leaflet_surface(int k, double rho, double s, double inset = 0.0) const;
+  // Lowest point of the closed leaflets above the annulus plane (negative: below it).
+  double leaflet_lowest() const;
+  // Radius inside which the closed leaflets' projection covers the lumen: the narrowest attachment radius,
+  // min(annulus_radius, commissure_radius). Use it as the disc radius of orifice_area for this valve.
+  double orifice_radius() const;
+  // Lumen cross-section area at the annulus plane.
+  double annulus_area() const;
+
+  std::vector<Vec3> wall_points(double dx, SurfaceMesh* mesh) const;
+  std::vector<Vec3> leaflet_points(int k, double dx, std::vector<uint8_t>* clamped) const;
+  std::vector<Vec3> blood_points(double dx) const;
+
+  Vec3 to_world(double r, double theta, double y) const;
+
+ private:
+  double midline_length(double sag) const;
+  double bump(double s, double y) const;
+
+  AorticRootParams p_;
+  double phi_[3], dphi_[3];
+  double y_c_ = 0.0, sag_ = 0.0, bulge_ = 0.0;
+};
+
+// Thin-leaflet scaling. A real leaflet is about t = 0.4 mm thick; the particle leaflet is layers x dx thick
+// (>= 3 layers), so it is far thicker. Plate bending stiffness is D = E t^3 / (12 (1 - nu^2)); with the same
+// Poisson ratio, the model leaflet bends like the real one when E_model t_model^3 = E_real t_real^3:
+//     E_model = E_real (t_real / t_model)^3.
+// Example (real E = 2 MPa, t = 0.4 mm, nu = 0.45): 3 layers at dx = 1 mm (t = 3 mm): 4.74 kPa; at
+// dx = 0.5 mm (1.5 mm): 37.9 kPa. In-plane (membrane) stiffness E t is then (t_real / t_model)^2 too soft;
+// the mass per area, if the density is kept (1100 kg/m^3), is t_model / t_real too high.
+double bending_equivalent_modulus(double real_youngs_modulus, double real_thickness, double model_thickness);
+
+}  // namespace aortasph

@@ -1,0 +1,481 @@
+// The parametric aortic root (issue 6): dimensions measured back from the generated particles, the closed
+// valve's orifice, no overlap between parts, clamping, the wall mesh, and bad geometry refused by the loader.
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <numbers>
+
+#include "aortic_root.hpp"
+#include "errors.hpp"
+#include "orifice.hpp"
+#include "scene_loader.hpp"
+#include "shapes.hpp"
+#include "world.hpp"
+
+using namespace aortasph;
+using json = nlohmann::json;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+struct Polar {
+  double r, theta, y;
+};
+Polar polar(const Vec3& q, const Vec3& base) {
+  const Vec3 d = q - base;
+  return {std::hypot(d.x(), d.z()), std::atan2(-d.z(), d.x()), d.y()};
+}
+
+// Angle between two polar angles, in [0, pi].
+double angle_between(double a, double b) {
+  const double d = std::fmod(std::abs(a - b), 2 * kPi);
+  return std::min(d, 2 * kPi - d);
+}
+
+struct Parts {
+  std::vector<Vec3> wall, blood;
+  std::vector<Vec3> leaflet[3];
+  std::vector<uint8_t> clamped[3];
+  SurfaceMesh mesh;
+};
+
+Parts generate(const AorticRootParams& p, double dx) {
+  Parts out;
+  ShapeSample w = sample_aortic_root(p, AorticPart::Wall, 0, dx);
+  out.wall = std::move(w.points);
+  out.mesh = std::move(w.mesh);
+  out.blood = sample_aortic_root(p, AorticPart::Blood, 0, dx).points;
+  for (int k = 0; k < 3; ++k) {
+    ShapeSample l = sample_aortic_root(p, AorticPart::Leaflet, k, dx);
+    out.leaflet[k] = std::move(l.points);
+    out.clamped[k] = std::move(l.clamped);
+  }
+  return out;
+}
+
+// Least-squares polynomial y(r) of degree 4 through the points (so the layers of a sheet average to its
+// mid-surface), from r = 0 to r = r_end. Returns its arc length and its height at r_end.
+std::pair<double, double> profile(const std::vector<Polar>& pts, double r_end) {
+  REQUIRE(pts.size() >= 10);
+  const int deg = 4;
+  Eigen::MatrixXd A(pts.size(), deg + 1);
+  Eigen::VectorXd b(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    for (int d = 0; d <= deg; ++d) A(i, d) = std::pow(pts[i].r / r_end, d);
+    b(i) = pts[i].y;
+  }
+  const Eigen::VectorXd c = A.colPivHouseholderQr().solve(b);
+  auto y = [&](double r) {
+    double v = 0;
+    for (int d = deg; d >= 0; --d) v = v * (r / r_end) + c(d);
+    return v;
+  };
+  double len = 0;
+  const int n = 1000;
+  for (int i = 0; i < n; ++i) len += std::hypot(r_end / n, y(r_end * (i + 1) / n) - y(r_end * i / n));
+  return {len, y(r_end)};
+}
+
+struct Measured {
+  double annulus_radius, commissure_radius, commissure_height, free_edge, leaflet_height, sinus_radius;
+  double orifice_fraction;
+};
+
+Measured measure(const AorticRootParams& p, const Parts& parts, double dx) {
+  const AorticRoot root(p);
+  Measured m{};
+  // Annulus radius: the wall's innermost layer in the last ring below the annulus plane, less half a spacing.
+  // Commissure radius: the innermost layer at each commissure (within one spacing of its height and of its
+  // radial plane), less half a spacing. Sinus radius: the widest innermost layer, less half a spacing.
+  double ann = 0, ann_n = 0, com = 0, com_n = 0, sinus = 0;
+  double ring_y = -1e9;
+  for (const Vec3& q : parts.wall) {
+    const Polar a = polar(q, p.base);
+    if (a.y < 0) ring_y = std::max(ring_y, a.y);
+  }
+  for (const Vec3& q : parts.wall) {
+    const Polar a = polar(q, p.base);
+    const double inner = a.r - root.lumen_radius(a.y, a.theta);
+    if (inner > dx) continue;  // outer layers
+    if (std::abs(a.y - ring_y) < 1e-9) {
+      ann += a.r - 0.5 * dx;
+      ++ann_n;
+    }
+    for (int k = 0; k < 3; ++k)
+      if (std::abs(a.y - p.commissure_height) < dx &&
+          angle_between(a.theta, root.sector_start(k)) * a.r < dx) {
+        com += a.r - 0.5 * dx;
+        ++com_n;
+      }
+    if (a.y > 0 && a.y < p.commissure_height) sinus = std::max(sinus, a.r - 0.5 * dx);
+  }
+  REQUIRE(ann_n > 0);
+  REQUIRE(com_n > 0);
+  m.annulus_radius = ann / ann_n;
+  m.commissure_radius = com / com_n;
+  m.sinus_radius = sinus;
+
+  // Free edge: the leaflet particles along each coaptation line (within 0.55 dx of the commissure's radial
+  // plane, both neighbouring leaflets, all layers: the rows end 0.5 dx from it) fitted by a quartic y(r)
+  // from the axis to the measured commissure radius; the free edge is twice its arc length, the commissure
+  // height its end. Leaflet height: the same fit to the particles within 0.75 dx of each leaflet's bisector,
+  // from the axis to the measured annulus radius.
+  double fe = 0, ch = 0, lh = 0;
+  for (int k = 0; k < 3; ++k) {
+    std::vector<Polar> edge, mid;
+    const double phi = root.sector_start(k), bisector = phi + 0.5 * root.sector_width(k);
+    for (int l = 0; l < 3; ++l)
+      for (const Vec3& q : parts.leaflet[l]) {
+        const Polar a = polar(q, p.base);
+        if (std::sin(angle_between(a.theta, phi)) * a.r < 0.55 * dx && angle_between(a.theta, phi) < kPi / 2)
+          edge.push_back(a);
+        if (l == k && std::sin(angle_between(a.theta, bisector)) * a.r < 0.75 * dx &&
+            angle_between(a.theta, bisector) < kPi / 2)
+          mid.push_back(a);
+      }
+    const auto [half, y_end] = profile(edge, m.commissure_radius);
+    fe += 2 * half / 3;
+    ch += y_end / 3;
+    lh += profile(mid, m.annulus_radius).first / 3;
+  }
+  m.free_edge = fe;
+  m.commissure_height = ch;
+  m.leaflet_height = lh;
+
+  std::vector<Vec3> valve;
+  for (const auto& l : parts.leaflet) valve.insert(valve.end(), l.begin(), l.end());
+  m.orifice_fraction =
+      orifice_area(valve, dx, p.base, Vec3::UnitY(), root.orifice_radius()) / root.annulus_area();
+  return m;
+}
+
+// Smallest distance between a point of a and a point of b (hash grid of cell `reach`); reach if none closer.
+double min_distance(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double reach) {
+  std::map<std::tuple<int, int, int>, std::vector<Vec3>> grid;
+  auto key = [&](const Vec3& q) {
+    return std::tuple{static_cast<int>(std::floor(q.x() / reach)),
+                      static_cast<int>(std::floor(q.y() / reach)),
+                      static_cast<int>(std::floor(q.z() / reach))};
+  };
+  for (const Vec3& q : b) grid[key(q)].push_back(q);
+  double best = reach;
+  for (const Vec3& q : a) {
+    const auto [i, j, k] = key(q);
+    for (int di = -1; di <= 1; ++di)
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int dk = -1; dk <= 1; ++dk) {
+          const auto it = grid.find({i + di, j + dj, k + dk});
+          if (it == grid.end()) continue;
+          for (const Vec3& o : it->second) best = std::min(best, (o - q).norm());
+        }
+  }
+  return best;
+}
+
+void check_dimensions(const AorticRootParams& p, double dx) {
+  const Parts parts = generate(p, dx);
+  const Measured m = measure(p, parts, dx);
+  INFO("dx " << dx << ": annulus " << m.annulus_radius << ", commissure r " << m.commissure_radius << " h "
+             << m.commissure_height << ", free edge " << m.free_edge << ", leaflet height "
+             << m.leaflet_height << ", sinus " << m.sinus_radius << ", orifice " << m.orifice_fraction);
+  CHECK(m.annulus_radius == Approx(p.annulus_radius).epsilon(0.05));
+  CHECK(m.commissure_radius == Approx(p.commissure_radius).epsilon(0.05));
+  CHECK(m.commissure_height == Approx(p.commissure_height).epsilon(0.05));
+  CHECK(m.free_edge == Approx(p.leaflet_free_edge).epsilon(0.05));
+  CHECK(m.leaflet_height == Approx(p.leaflet_height).epsilon(0.05));
+  if (p.sinuses) CHECK(m.sinus_radius == Approx(p.sinus_radius).epsilon(0.05));
+  CHECK(m.orifice_fraction < 0.02);
+}
+
+}  // namespace
+
+TEST_CASE("aortic root: dimensions measured from the particles match the parameters", "[aortic]") {
+  AorticRootParams p;  // Labrosse et al. 2006 defaults
+  p.base = Vec3(0.01, -0.02, 0.005);
+  check_dimensions(p, 0.001);
+  check_dimensions(p, 0.0005);
+}
+
+TEST_CASE("aortic root: a graft without sinuses and unequal commissures", "[aortic]") {
+  AorticRootParams p;
+  p.sinuses = false;
+  p.commissure_radius = p.annulus_radius;
+  p.commissure_angles = {10.0, 115.0, 250.0};
+  check_dimensions(p, 0.001);
+  const AorticRoot root(p);
+  // A straight tube: the lumen radius is the annulus radius everywhere up to the aorta.
+  for (double y : {-0.005, 0.0, 0.008, 0.016, 0.03})
+    for (double th : {0.0, 1.0, 2.5, 4.0}) CHECK(root.lumen_radius(y, th) == Approx(p.annulus_radius));
+}
+
+TEST_CASE("aortic root: parts do not overlap and blood stays in the lumen", "[aortic]") {
+  AorticRootParams p;
+  p.commissure_angles = {0.0, 110.0, 245.0};
+  const double dx = 0.001;
+  const Parts parts = generate(p, dx);
+  const AorticRoot root(p);
+  // World refuses particles of two bodies closer than 0.5 dx; the generator keeps about dx.
+  for (int k = 0; k < 3; ++k) {
+    CHECK(min_distance(parts.leaflet[k], parts.wall, 2 * dx) >= 0.8 * dx);
+    CHECK(min_distance(parts.leaflet[k], parts.blood, 2 * dx) >= 0.85 * dx);
+    CHECK(min_distance(parts.leaflet[k], parts.leaflet[(k + 1) % 3], 2 * dx) >= 0.85 * dx);
+    // Coaptation: neighbouring leaflets meet within about one spacing along their common free edge.
+    CHECK(min_distance(parts.leaflet[k], parts.leaflet[(k + 1) % 3], 2 * dx) <= 1.05 * dx);
+  }
+  CHECK(min_distance(parts.blood, parts.wall, 2 * dx) >= 0.55 * dx);
+  for (const Vec3& q : parts.blood) {
+    const Polar a = polar(q, p.base);
+    REQUIRE(a.r < root.lumen_radius(a.y, a.theta));
+    REQUIRE(a.y > -p.lvot_length);
+    REQUIRE(a.y < p.stj() + p.aorta_length);
+  }
+  // Blood fills the sinuses behind the leaflets too.
+  int behind = 0;
+  for (const Vec3& q : parts.blood) {
+    const Polar a = polar(q, p.base);
+    if (a.y > 0.004 && a.y < 0.012 && a.r > p.annulus_radius) ++behind;
+  }
+  CHECK(behind > 100);
+}
+
+TEST_CASE("aortic root: leaflets are layered sheets clamped along their attachment", "[aortic]") {
+  AorticRootParams p;
+  const double dx = 0.001;
+  const AorticRoot root(p);
+  for (int k = 0; k < 3; ++k) {
+    const ShapeSample l = sample_aortic_root(p, AorticPart::Leaflet, k, dx);
+    REQUIRE(l.clamped.size() == l.points.size());
+    std::size_t n_clamped = 0, second_row = 0;
+    for (std::size_t i = 0; i < l.points.size(); ++i) {
+      const Polar a = polar(l.points[i], p.base);
+      const double depth = (root.lumen_radius(a.y, a.theta) - a.r) / root.normal_scale(a.y, a.theta);
+      if (l.clamped[i]) {
+        ++n_clamped;
+        CHECK(depth < 1.75 * dx);
+        if (depth > 1.0 * dx) ++second_row;
+      } else {
+        CHECK(depth >= 1.75 * dx);
+      }
+    }
+    CHECK(n_clamped > 50);
+    CHECK(second_row > 20);
+    // Nearest neighbours inside the sheet about one spacing apart.
+    double sum = 0;
+    for (std::size_t i = 0; i < l.points.size(); ++i) {
+      double best = 1e9;
+      for (std::size_t j = 0; j < l.points.size(); ++j)
+        if (j != i) best = std::min(best, (l.points[j] - l.points[i]).norm());
+      sum += best;
+      CHECK(best > 0.6 * dx);
+    }
+    CHECK(sum / l.points.size() == Approx(dx).epsilon(0.12));
+  }
+  // Three layers, leaflet thickness 3 dx: the sheet holds about 3 x (area / dx^2) particles.
+  const ShapeSample one = sample_aortic_root(p, AorticPart::Leaflet, 0, dx);
+  const double area_guess = 0.5 * p.leaflet_free_edge * p.leaflet_height;  // order of magnitude
+  CHECK(one.points.size() > 1.5 * area_guess / (dx * dx));
+  CHECK(one.points.size() < 6.0 * area_guess / (dx * dx));
+}
+
+TEST_CASE("aortic root: the wall mesh is closed around the axis and faces the lumen", "[aortic]") {
+  AorticRootParams p;
+  const ShapeSample w = sample_aortic_root(p, AorticPart::Wall, 0, 0.001);
+  REQUIRE(!w.mesh.empty());
+  std::size_t inward = 0;
+  for (const auto& t : w.mesh.triangles) {
+    Vec3 v[3];
+    for (int i = 0; i < 3; ++i)
+      v[i] = Vec3(w.mesh.vertices[t[i]][0], w.mesh.vertices[t[i]][1], w.mesh.vertices[t[i]][2]);
+    const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]);
+    const Vec3 c = (v[0] + v[1] + v[2]) / 3;
+    const Vec3 to_axis = Vec3(p.base.x(), c.y(), p.base.z()) - c;
+    if (n.dot(to_axis) > 0) ++inward;
+  }
+  CHECK(inward == w.mesh.triangles.size());
+  // Every edge is shared by two triangles except along the two open ends.
+  std::map<std::pair<uint32_t, uint32_t>, int> edges;
+  for (const auto& t : w.mesh.triangles)
+    for (int i = 0; i < 3; ++i) ++edges[std::minmax(t[i], t[(i + 1) % 3])];
+  std::size_t boundary = 0;
+  for (const auto& [e, n] : edges) {
+    CHECK(n <= 2);
+    if (n == 1) ++boundary;
+  }
+  CHECK(boundary == 2 * 144);  // 144 columns around, bottom and top rings
+}
+
+TEST_CASE("aortic root: orifice_area sees an open leaflet", "[aortic]") {
+  AorticRootParams p;
+  const double dx = 0.001;
+  const Parts parts = generate(p, dx);
+  const AorticRoot root(p);
+  std::vector<Vec3> two = parts.leaflet[0];
+  two.insert(two.end(), parts.leaflet[2].begin(), parts.leaflet[2].end());
+  const double disc = kPi * root.orifice_radius() * root.orifice_radius();
+  // Without leaflet 1, its sector (a third of the disc, less the half spacing its neighbours cover) is open.
+  const double open = orifice_area(two, dx, p.base, Vec3::UnitY(), root.orifice_radius());
+  CHECK(open == Approx(disc / 3).epsilon(0.1));
+  // Nothing covers anything: the whole disc; a square lattice of pitch dx covers all of it.
+  CHECK(orifice_area({}, dx, p.base, Vec3::UnitY(), 0.01) == Approx(kPi * 1e-4).epsilon(0.01));
+  std::vector<Vec3> lattice;
+  for (int i = -12; i <= 12; ++i)
+    for (int k = -12; k <= 12; ++k) lattice.push_back(Vec3(i * dx, 0.3 * i * dx, k * dx));
+  CHECK(orifice_area(lattice, dx, Vec3::Zero(), Vec3::UnitY(), 0.01) == 0.0);
+}
+
+TEST_CASE("aortic root: generation is deterministic", "[aortic]") {
+  AorticRootParams p;
+  p.commissure_angles = {5.0, 130.0, 250.0};
+  for (AorticPart part : {AorticPart::Wall, AorticPart::Blood, AorticPart::Leaflet}) {
+    const ShapeSample a = sample_aortic_root(p, part, 1, 0.001), b = sample_aortic_root(p, part, 1, 0.001);
+    REQUIRE(a.points.size() == b.points.size());
+    CHECK(std::equal(a.points.begin(), a.points.end(), b.points.begin()));
+    CHECK(a.clamped == b.clamped);
+  }
+}
+
+TEST_CASE("aortic root: bending-equivalent leaflet modulus", "[aortic]") {
+  // E t^3 kept: 2 MPa at 0.4 mm equals 4.74 kPa at 3 mm.
+  CHECK(bending_equivalent_modulus(2e6, 0.4e-3, 3e-3) == Approx(2e6 * std::pow(0.4 / 3.0, 3)));
+  CHECK(bending_equivalent_modulus(2e6, 0.4e-3, 3e-3) * std::pow(3e-3, 3) ==
+        Approx(2e6 * std::pow(0.4e-3, 3)));
+}
+
+TEST_CASE("aortic root report: particle counts and measured dimensions", "[.aortic-report]") {
+  for (double dx : {0.001, 0.0005}) {
+    AorticRootParams p;
+    const Parts parts = generate(p, dx);
+    const Measured m = measure(p, parts, dx);
+    std::size_t clamped = 0;
+    for (const auto& c : parts.clamped)
+      for (uint8_t f : c) clamped += f;
+    std::cout << "dx " << dx << ": wall " << parts.wall.size() << ", blood " << parts.blood.size()
+              << ", leaflets " << parts.leaflet[0].size() << " " << parts.leaflet[1].size() << " "
+              << parts.leaflet[2].size() << " (clamped " << clamped << ")\n  annulus r " << m.annulus_radius
+              << ", commissure r " << m.commissure_radius << ", commissure h " << m.commissure_height
+              << ", free edge " << m.free_edge << ", leaflet height " << m.leaflet_height << ", sinus r "
+              << m.sinus_radius << ", orifice / annulus area " << m.orifice_fraction << "\n  coaptation y "
+              << AorticRoot(p).coaptation_height() << ", sag " << AorticRoot(p).belly_sag() << ", lowest "
+              << AorticRoot(p).leaflet_lowest() << "\n";
+  }
+}
+
+namespace {
+
+json root_scene() {
+  std::ifstream f(std::string(AORTASPH_TEST_DIR) + "/data/aortic_root_geometry.json");
+  return json::parse(f);
+}
+
+std::string load_error(const json& j, const std::vector<std::string>& sets = {}) {
+  try {
+    load_scene_json(j, sets);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("aortic root scenes: shared geometry, per-shape overrides, --set", "[aortic][scene]") {
+  const LoadedScene l = load_scene_json(root_scene(), {"aortic_root.annulus_radius=0.014"});
+  REQUIRE(l.scene.bodies.size() == 5);
+  const Shape& wall = l.scene.bodies[0].shape;
+  CHECK(wall.kind == ShapeKind::AorticRoot);
+  CHECK(wall.aortic_part == AorticPart::Wall);
+  CHECK(wall.aortic.annulus_radius == 0.014);
+  CHECK(l.scene.bodies[4].shape.aortic_part == AorticPart::Leaflet);
+  CHECK(l.scene.bodies[4].shape.aortic_index == 2);
+  CHECK(l.scene.bodies[4].shape.aortic.annulus_radius == 0.014);
+  // Defaults are filled into the shared object (not stj_height / aorta_radius, which follow other values).
+  CHECK(l.resolved["aortic_root"]["wall_layers"] == 3);
+  CHECK(l.resolved["aortic_root"]["sinuses"] == true);
+  CHECK(!l.resolved["aortic_root"].contains("stj_height"));
+
+  // A shape's own key overrides the shared one.
+  json j = root_scene();
+  j["bodies"][2]["shape"]["aortic_root"]["leaflet_layers"] = 2;
+  const LoadedScene o = load_scene_json(j, {});
+  CHECK(o.scene.bodies[2].shape.aortic.leaflet_layers == 2);
+  CHECK(o.scene.bodies[3].shape.aortic.leaflet_layers == 3);
+
+  // Without a shared object every shape carries (and fills) its own parameters.
+  json k = root_scene();
+  k.erase("aortic_root");
+  const LoadedScene n = load_scene_json(k, {"bodies.0.shape.aortic_root.sinuses=false"});
+  CHECK(!n.scene.bodies[0].shape.aortic.sinuses);
+  CHECK(n.scene.bodies[1].shape.aortic.sinuses);
+  CHECK(n.resolved["bodies"][1]["shape"]["aortic_root"]["annulus_radius"] == 0.013);
+}
+
+TEST_CASE("aortic root scenes: impossible geometry is refused naming the parameter",
+          "[aortic][scene][bad-input]") {
+  const json j = root_scene();
+  struct Case {
+    std::vector<std::string> sets;
+    std::string expect;
+  };
+  const std::vector<Case> cases = {
+      {{"aortic_root.commissure_radius=0.019"},
+       "aortic_root.commissure_radius: must be smaller than sinus_radius"},
+      {{"aortic_root.sinus_radius=0.012"},
+       "aortic_root.commissure_radius: must be smaller than sinus_radius"},
+      {{"aortic_root.leaflet_free_edge=0.02"}, "aortic_root.leaflet_free_edge: 0.02 is too short to close"},
+      {{"aortic_root.leaflet_free_edge=0.05"}, "aortic_root.leaflet_free_edge: 0.05 is too long"},
+      {{"aortic_root.leaflet_height=0.01"}, "aortic_root.leaflet_height: 0.01 is too short"},
+      {{"aortic_root.leaflet_height=0.04"}, "aortic_root.leaflet_height: 0.04 is too long"},
+      {{"aortic_root.commissure_angles=[0,240,120]"}, "aortic_root.commissure_angles: must increase"},
+      {{"aortic_root.commissure_angles=[0,20,200]"},
+       "aortic_root.commissure_angles: commissures 0 and 1 are 20"},
+      {{"aortic_root.commissure_angles=[0,120,340]"}, "commissures 2 and 0 are 20 degrees apart"},
+      {{"aortic_root.commissure_angles=[0,120]"}, "aortic_root.commissure_angles: expected 3 numbers, got 2"},
+      {{"aortic_root.stj_height=0.01"}, "aortic_root.stj_height: must not lie below commissure_height"},
+      {{"aortic_root.annulus_radius=-0.01"}, "aortic_root.annulus_radius: must be positive"},
+      {{"aortic_root.lvot_length=0.0005"}, "aortic_root.lvot_length"},
+      {{"aortic_root.sinuses=1"}, "aortic_root.sinuses: expected true or false"},
+      {{"resolution.spacing=0.004"}, "resolution.spacing: spacing 0.004 is too coarse"},
+      {{"bodies.0.shape.aortic_root.commissure_radius=0.02"},
+       "bodies[0].shape.aortic_root.commissure_radius: must be smaller than sinus_radius"},
+      {{"bodies.0.shape.aortic_root.part=valve"}, "bodies[0].shape.aortic_root.part: unknown value 'valve'"},
+      {{"bodies.0.shape.aortic_root.index=1"},
+       "bodies[0].shape.aortic_root.index: only leaflets have an index"},
+      {{"bodies.1.material=wall"}, "bodies[1].material: the aortic root's blood needs a fluid material"},
+      {{"bodies.0.material=blood"}, "bodies[0].material: the aortic root's wall needs a wall material"},
+  };
+  for (const Case& c : cases) {
+    INFO(c.sets[0]);
+    const std::string e = load_error(j, c.sets);
+    CHECK_THAT(e, Catch::Contains(c.expect));
+  }
+  json no_index = j;
+  no_index["bodies"][2]["shape"]["aortic_root"].erase("index");
+  CHECK_THAT(load_error(no_index), Catch::Contains("bodies[2].shape.aortic_root.index: missing"));
+  json typo = j;
+  typo["aortic_root"]["annulus_raduis"] = 0.013;
+  CHECK_THAT(load_error(typo), Catch::Contains("aortic_root.annulus_raduis: unknown key"));
+}
+
+TEST_CASE("aortic root scenes: aortasph check builds the world, bad geometry exits 2", "[aortic][scene]") {
+  const std::string scene = std::string(AORTASPH_TEST_DIR) + "/data/aortic_root_geometry.json";
+  const std::string bin = AORTASPH_BINARY;
+  auto run = [&](const std::string& args) {
+    const int status = std::system((bin + " " + args + " > /dev/null 2>&1").c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  // World refuses bodies closer than dx / 2: check succeeds, so wall, blood and leaflets do not overlap.
+  CHECK(run("check " + scene) == 0);
+  CHECK(run("check " + scene + " --set aortic_root.commissure_angles=[0,100,230]") == 0);
+  CHECK(run("check " + scene + " --set aortic_root.sinuses=false") == 0);
+  // Narrow sinuses have steep walls: blood and leaflets keep their distance along the wall's normal.
+  CHECK(run("check " + scene + " --set aortic_root.commissure_angles=[0,40,80]") == 0);
+  CHECK(run("check " + scene + " --set aortic_root.commissure_radius=0.02") == 2);
+  CHECK(run("check " + scene + " --set aortic_root.commissure_angles=[0,10,240]") == 2);
+}
