@@ -601,14 +601,15 @@ class Loader {
     if (type == "body") keys.insert(keys.end(), {"body"});
     if (type == "point") keys.insert(keys.end(), {"body", "reference"});
     if (type == "flow_rate") keys.insert(keys.end(), {"point", "normal", "radius"});
-    if (type == "orifice_area") keys.insert(keys.end(), {"body", "point", "normal"});
+    if (type == "orifice_area") keys.insert(keys.end(), {"body", "bodies", "point", "normal", "radius"});
+    if (type == "stress") keys.insert(keys.end(), {"bodies"});
     Obj o(j, path, keys, allowed);
     Probe p;
     p.name = o.string("name");
     if (p.name.empty() || p.name.find_first_of(",\"\n") != std::string::npos)
       fail(o.path("name"), "must be a non-empty name without commas or quotes");
     o.choice("type", {"extent", "pressure", "body", "point", "energy", "momentum", "flow_rate",
-                      "orifice_area", "open_boundary"});
+                      "orifice_area", "open_boundary", "stress"});
     if (type == "extent") {
       p.type = ProbeType::Extent;
       const auto names = o.strings("bodies");
@@ -644,11 +645,38 @@ class Loader {
       p.point = o.vec3("point");
       p.normal = o.unit("normal");
       p.radius = o.positive("radius");
+    } else if (type == "stress") {
+      p.type = ProbeType::Stress;
+      const auto names = o.strings("bodies");
+      if (names.empty()) fail(o.path("bodies"), "expected at least one body");
+      for (std::size_t k = 0; k < names.size(); ++k) {
+        p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
+        if (s.materials[s.bodies[p.bodies.back()].material].type != MaterialType::Elastic)
+          fail(index(o.path("bodies"), k), "body '" + names[k] + "' is not elastic: it carries no stress");
+      }
     } else {
+      // The valve: one body (SPEC) or several (`bodies`: the three leaflets of an aortic valve).
       p.type = ProbeType::OrificeArea;
-      p.body = body_index(s, o.string("body"), o.path("body"));
+      if (o.has("body") == o.has("bodies")) fail(path, "orifice_area needs either 'body' or 'bodies'");
+      if (o.has("body")) {
+        p.bodies.push_back(body_index(s, o.string("body"), o.path("body")));
+      } else {
+        const auto names = o.strings("bodies");
+        if (names.empty()) fail(o.path("bodies"), "expected at least one body");
+        for (std::size_t k = 0; k < names.size(); ++k)
+          p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
+      }
       p.point = o.vec3("point");
       p.normal = o.unit("normal");
+      if (o.has("radius")) {
+        p.radius = o.positive("radius");
+      } else {
+        // Default: the valve's own disc, when it is an aortic_root leaflet (AorticRoot::orifice_radius()).
+        const Shape& sh = s.bodies[p.bodies.front()].shape;
+        if (sh.kind != ShapeKind::AorticRoot)
+          fail(o.path("radius"), "required unless the valve is an aortic_root leaflet");
+        p.radius = AorticRoot(sh.aortic).orifice_radius();
+      }
     }
     return p;
   }

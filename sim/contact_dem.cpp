@@ -33,7 +33,7 @@ void contact_forces(const Particles& P, const NeighborSearch& nb, const ContactP
   const auto& idx = nb.index();
   const double d2 = c.distance * c.distance;
   parallel_for_dynamic(P.size(), [&](std::size_t i) {
-    if (fluid_like(P.kind[i])) return;
+    if (fluid_like(P.kind[i]) || P.kind[i] == Kind::Wall) return;  // walls never move: no force needed
     Vec3 sum = Vec3::Zero(), mom = Vec3::Zero();
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];

@@ -97,6 +97,27 @@ void OpenBoundaries::setup(const Scene& scene, const std::vector<FluidParams>& f
   state_ = OpenBoundaryState{};
   state_.next_id = next;
 
+  // Fluid that starts behind an inlet disc (a fluid body filling the inlet tube to its end) gives way to the
+  // inflow buffer: fluid particles within the buffer's slab and one kernel support behind it (up to a quarter
+  // spacing in front of the disc), within the disc's radius plus a spacing, are removed before the buffer is
+  // laid.
+  {
+    std::vector<uint32_t> keep;
+    keep.reserve(P.size());
+    for (std::size_t i = 0; i < P.size(); ++i) {
+      bool behind = false;
+      if (P.kind[i] == Kind::Fluid)
+        for (const Zone& z : zones_) {
+          if (z.spec.type != OpenBoundaryType::Inflow) continue;
+          const double a = z.axial(P.x[i]);
+          if (a < 0.25 * dx && a >= -z.depth - support_ && z.radial(P.x[i]) < z.spec.radius + dx)
+            behind = true;
+        }
+      if (!behind) keep.push_back(static_cast<uint32_t>(i));
+    }
+    if (keep.size() < P.size()) P.permute(keep);
+  }
+
   // The inflow buffers: `layers` lattice layers behind each inlet disc.
   const std::size_t first_buffer = P.size();
   for (const Zone& z : zones_) {

@@ -1,8 +1,11 @@
 #include "probes.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 
+#include "orifice.hpp"
 #include "parallel.hpp"
 #include "sim_errors.hpp"
 
@@ -77,8 +80,11 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
                      "mass_inside"});
         break;
       case ProbeType::OrificeArea:
-        throw SetupError("probes[" + std::to_string(k) + "] '" + pr.name +
-                         "': orifice_area needs an elastic valve, which this version cannot simulate yet");
+        columns_.push_back(pr.name);
+        break;
+      case ProbeType::Stress:
+        add_columns(columns_, pr.name, {"max", "mean"});
+        break;
     }
   }
 }
@@ -251,8 +257,46 @@ std::vector<double> ProbeSet::measure(const World& world) const {
                                st.mass_in, st.mass_out, inside.m});
         break;
       }
-      case ProbeType::OrificeArea:
-        break;  // refused in the constructor
+      case ProbeType::OrificeArea: {
+        // Open area of the valve projected on the disc (sim/orifice.hpp), the valve's particles in array
+        // order (the raster does not depend on the order).
+        std::vector<char> in_set(world.bodies().size(), 0);
+        for (int b : pr.bodies) in_set[b] = 1;
+        std::vector<Vec3> pts;
+        for (std::size_t i = 0; i < n; ++i)
+          if (in_set[P.body[i]]) pts.push_back(P.x[i]);
+        out.push_back(orifice_area(pts, world.scene().spacing, pr.point, pr.normal, pr.radius));
+        break;
+      }
+      case ProbeType::Stress: {
+        // Largest and mean von Mises stress (eqs. 16-17, sim/solid_tlsph.hpp) over the bodies' particles.
+        std::vector<char> in_set(world.bodies().size(), 0);
+        for (int b : pr.bodies) in_set[b] = 1;
+        const Solids& S = world.solids();
+        struct MS {
+          double max = 0, sum = 0, count = 0;
+        };
+        const MS r = parallel_reduce(
+            S.size(), MS{},
+            [&](std::size_t s) {
+              if (!in_set[P.body[S.at(s)]]) return MS{};
+              const double vm = S.von_mises(s);
+              return MS{vm, vm, 1.0};
+            },
+            [](const MS& a, const MS& b) {
+              return MS{std::max(a.max, b.max), a.sum + b.sum, a.count + b.count};
+            });
+        out.insert(out.end(), {r.max, r.count > 0 ? r.sum / r.count : 0.0});
+        if (std::getenv("AORTASPH_DEBUG_STRESS"))
+          for (std::size_t s = 0; s < S.size(); ++s)
+            if (S.von_mises(s) > 0.2 * r.max) {
+              const std::size_t i = S.at(s);
+              std::fprintf(stderr, "t %g stress %g id %u body %d clamped %d x %g %g %g x0 %g %g %g\n",
+                           world.time(), S.von_mises(s), P.id[i], P.body[i], S.clamped(s), P.x[i].x(),
+                           P.x[i].y(), P.x[i].z(), P.x0[i].x(), P.x0[i].y(), P.x0[i].z());
+            }
+        break;
+      }
     }
   }
   return out;

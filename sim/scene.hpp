@@ -122,13 +122,14 @@ enum class ProbeType {
   Momentum,
   FlowRate,
   OrificeArea,
-  OpenBoundary
+  OpenBoundary,
+  Stress
 };
 
 struct Probe {
   std::string name;
   ProbeType type = ProbeType::Extent;
-  std::vector<int> bodies;  // extent: indices into Scene::bodies
+  std::vector<int> bodies;  // extent, orifice_area, stress: indices into Scene::bodies
   int body = -1;            // body, point, orifice_area
   int axis = 0;             // extent: 0,1,2 = x,y,z
   bool stat_max = true;     // extent: max or min
@@ -136,7 +137,7 @@ struct Probe {
   Vec3 point = Vec3::Zero();      // pressure, flow_rate, orifice_area
   Vec3 normal = Vec3::UnitY();    // flow_rate, orifice_area
   Vec3 reference = Vec3::Zero();  // point
-  double radius = 0.0;            // flow_rate
+  double radius = 0.0;            // flow_rate, orifice_area
 };
 
 // A value that may vary in time: one constant, or a table of (t, value) pairs with strictly increasing times,

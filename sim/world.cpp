@@ -185,8 +185,15 @@ World::World(const Scene& scene)
   max_accel_ = gravity_.norm();
   for (const Vec3& v : P_.v) max_speed_ = std::max(max_speed_, v.norm());
 
-  // Elastic solids: reference configuration, neighbours and corrections, once.
-  clamped.resize(P_.size(), 0);
+  // Elastic solids: reference configuration, neighbours and corrections, once. `clamped` was filled by
+  // sampling index, which is the particle id; the open boundaries may have removed fluid since, so it is read
+  // by id.
+  {
+    std::vector<uint8_t> by_index(P_.size(), 0);
+    for (std::size_t i = 0; i < P_.size(); ++i)
+      if (P_.id[i] < clamped.size()) by_index[i] = clamped[P_.id[i]];
+    clamped = std::move(by_index);
+  }
   solids_ = Solids(P_, scene_.materials, kernel_, dx, clamped);
   if (!solids_.empty() && contact_.k > 0.0)
     min_contact_mass_ = std::min(min_contact_mass_, solids_.min_mass());
@@ -221,6 +228,11 @@ double World::stable_dt() const {
   // and is then within 2 % of the spring-dashpot formula up to zeta = 0.5 (tests/test_rigid.cpp).
   if ((!rigid_.empty() || !solids_.empty()) && contact_.k > 0.0)
     dt = std::min(dt, scene_.cfl * 0.1 * std::sqrt(min_contact_mass_ / contact_.k));
+  // Contact dampers (eqs. 24, 25), explicit: a particle of mass m on a damper eta is stable for dt < 2 m /
+  // eta; cfl m / eta leaves room for the several contacts a particle may have at once.
+  if ((!rigid_.empty() || !solids_.empty()) && contact_.k > 0.0 &&
+      std::max(contact_.eta, contact_.shear) > 0.0)
+    dt = std::min(dt, scene_.cfl * min_contact_mass_ / std::max(contact_.eta, contact_.shear));
   // Force limit (Monaghan 1992): dt <= 0.25 sqrt(h / |a|max).
   if (max_accel_ > 0.0) dt = std::min(dt, 0.25 * std::sqrt(h / max_accel_));
   return dt;

@@ -538,9 +538,9 @@ TEST_CASE("open boundaries: a buffer outside the domain or overlapping a body ex
        "open_boundaries[1] 'outlet': the buffer (20 layers) reaches outside the domain"},
       {"overlap",
        [](json& j) {
-         j["open_boundaries"][0]["point"] = {0, 0.003, 0};
+         j["open_boundaries"][0]["radius"] = 0.005;  // wider than the tube: the buffer runs into its wall
        },
-       "open_boundaries[0] 'inlet': the inflow buffer overlaps body 'blood'"},
+       "open_boundaries[0] 'inlet': the inflow buffer overlaps body 'tube'"},
   };
   for (const Case& c : cases) {
     json j = tube_json();
@@ -561,4 +561,28 @@ TEST_CASE("open boundaries: a buffer outside the domain or overlapping a body ex
     CHECK(text.str().find(c.expect) != std::string::npos);
   }
   fs::remove_all(dir);
+}
+
+TEST_CASE("open boundaries: fluid behind an inlet disc gives way to the inflow buffer", "[open][scene]") {
+  // The blood fills the tube from y = 0; an inlet disc at y = 3 mm puts 3 of the buffer's 4 layers where
+  // blood is: that blood is removed, the buffer laid, and no two particles end up closer than the lattice.
+  json j = tube_json();
+  j["open_boundaries"][0]["point"] = {0, 0.003, 0};
+  const Scene s = load_scene_json(j, {}).scene;
+  const World w0(load_scene_json(tube_json(), {}).scene);
+  const World w(s);
+  const Particles& P = w.particles();
+  std::size_t inflow = 0, fluid = 0;
+  double closest = 1.0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.kind[i] == Kind::Inflow) ++inflow;
+    if (P.kind[i] != Kind::Fluid) continue;
+    ++fluid;
+    CHECK(P.x[i].y() > 0.003);  // nothing left behind the disc
+    for (std::size_t k = 0; k < P.size(); ++k)
+      if (P.kind[k] == Kind::Inflow) closest = std::min(closest, (P.x[i] - P.x[k]).norm());
+  }
+  CHECK(inflow == w0.count(Kind::Inflow));                 // the same buffer as with the disc below the blood
+  CHECK(fluid == w0.count(Kind::Fluid) - 3 * inflow / 4);  // three of its four layers were blood
+  CHECK(closest > 0.99e-3);
 }
