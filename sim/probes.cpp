@@ -287,14 +287,6 @@ std::vector<double> ProbeSet::measure(const World& world) const {
               return MS{std::max(a.max, b.max), a.sum + b.sum, a.count + b.count};
             });
         out.insert(out.end(), {r.max, r.count > 0 ? r.sum / r.count : 0.0});
-        if (std::getenv("AORTASPH_DEBUG_STRESS"))
-          for (std::size_t s = 0; s < S.size(); ++s)
-            if (S.von_mises(s) > 0.2 * r.max) {
-              const std::size_t i = S.at(s);
-              std::fprintf(stderr, "t %g stress %g id %u body %d clamped %d x %g %g %g x0 %g %g %g\n",
-                           world.time(), S.von_mises(s), P.id[i], P.body[i], S.clamped(s), P.x[i].x(),
-                           P.x[i].y(), P.x[i].z(), P.x0[i].x(), P.x0[i].y(), P.x0[i].z());
-            }
         break;
       }
     }

@@ -1,6 +1,5 @@
 #include "solid_tlsph.hpp"
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -103,13 +102,6 @@ Solids::Solids(const Particles& P, const std::vector<Material>& materials, const
       const uint32_t t = nbr_[k];
       const Vec3 Xst = X_[s] - X_[t];
       M += volume_[t] * kernel.gradW(Xst, Xst.norm()) * (X_[t] - X_[s]).transpose();
-    }
-    if (std::getenv("AORTASPH_DEBUG_L")) {
-      Eigen::JacobiSVD<Mat3> svd(M);
-      const auto sv = svd.singularValues();
-      if (sv(2) < 0.2 * sv(0))
-        std::fprintf(stderr, "L %zu id %u nbrs %u ratio %.3g x %g %g %g\n", s, id_[s],
-                     offset_[s + 1] - offset_[s], sv(2) / sv(0), X_[s].x(), X_[s].y(), X_[s].z());
     }
     const double scale = M.trace() / 3.0;
     if (std::abs(M.determinant()) > 1e-3 * std::abs(scale * scale * scale))
