@@ -360,7 +360,8 @@ class Loader {
                 "density_summation",
                 "background_pressure"};
       else if (type == "elastic")
-        keys = {"type", "density", "youngs_modulus", "poisson_ratio", "hourglass", "artificial_viscosity"};
+        keys = {"type", "density", "youngs_modulus", "poisson_ratio", "hourglass", "artificial_viscosity",
+                "model"};
       else if (type == "rigid")
         keys = {"type", "density"};
       Obj o(it.value(), path, keys, allowed);
@@ -384,6 +385,8 @@ class Loader {
           fail(o.path("poisson_ratio"), "must lie in (-1, 0.5), got " + json(m.poisson_ratio).dump());
         m.hourglass = o.non_negative("hourglass", 10.0);
         m.solid_art_viscosity = o.non_negative("artificial_viscosity", 1.0);
+        if (!o.has("model")) it.value()["model"] = "saint_venant_kirchhoff";
+        m.neo_hookean = o.choice("model", {"saint_venant_kirchhoff", "neo_hookean"}) == "neo_hookean";
       } else if (type == "rigid") {
         m.type = MaterialType::Rigid;
         m.density = o.positive("density");

@@ -40,7 +40,8 @@ struct Material {
   // Elastic (Total-Lagrangian SPH, paper section 3.2)
   double youngs_modulus = 0.0;
   double poisson_ratio = 0.0;
-  double hourglass = 10.0;           // Ganzenmueller 2015 hourglass coefficient
+  double hourglass = 10.0;   // Ganzenmueller 2015 hourglass coefficient
+  bool neo_hookean = false;  // false: Saint Venant-Kirchhoff (paper eq. 16); true: compressible neo-Hookean
   double solid_art_viscosity = 1.0;  // artificial viscosity alpha for solids
 };
 

@@ -21,7 +21,19 @@ SolidParams::SolidParams(const Material& m)
       mu(m.youngs_modulus / (2.0 * (1.0 + m.poisson_ratio))),
       c(std::sqrt((lambda + 2.0 * mu) / m.density)),
       hourglass(m.hourglass),
-      alpha(m.solid_art_viscosity) {}
+      alpha(m.solid_art_viscosity),
+      neo_hookean(m.neo_hookean) {}
+
+namespace {
+
+// Von Mises equivalent of a Cauchy stress.
+double von_mises_of(const Mat3& sig) {
+  const double d01 = sig(0, 0) - sig(1, 1), d12 = sig(1, 1) - sig(2, 2), d20 = sig(2, 2) - sig(0, 0);
+  const double shear = sig(0, 1) * sig(0, 1) + sig(1, 2) * sig(1, 2) + sig(2, 0) * sig(2, 0);
+  return std::sqrt(0.5 * (d01 * d01 + d12 * d12 + d20 * d20) + 3.0 * shear);
+}
+
+}  // namespace
 
 StressState svk_stress(const Mat3& F, double lambda, double mu) {
   StressState s;
@@ -36,9 +48,31 @@ StressState svk_stress(const Mat3& F, double lambda, double mu) {
   // Cauchy stress sigma = J^-1 P F^T = J^-1 F S F^T, and its von Mises equivalent.
   const double J = F.determinant();
   const Mat3 sig = (std::abs(J) > 1e-12 ? 1.0 / J : 0.0) * (s.P * F.transpose());
-  const double d01 = sig(0, 0) - sig(1, 1), d12 = sig(1, 1) - sig(2, 2), d20 = sig(2, 2) - sig(0, 0);
-  const double shear = sig(0, 1) * sig(0, 1) + sig(1, 2) * sig(1, 2) + sig(2, 0) * sig(2, 0);
-  s.von_mises = std::sqrt(0.5 * (d01 * d01 + d12 * d12 + d20 * d20) + 3.0 * shear);
+  s.von_mises = von_mises_of(sig);
+  return s;
+}
+
+namespace {
+
+StressState stress_of(const SolidParams& sp, const Mat3& F) {
+  return sp.neo_hookean ? neo_hookean_stress(F, sp.lambda, sp.mu) : svk_stress(F, sp.lambda, sp.mu);
+}
+
+}  // namespace
+
+StressState neo_hookean_stress(const Mat3& F, double lambda, double mu) {
+  StressState s;
+  const double J = std::max(F.determinant(), 0.01);
+  const Mat3 Finv = std::abs(F.determinant()) > 1e-12 ? Mat3(F.inverse()) : Mat3::Zero();
+  const Mat3 FinvT = Finv.transpose();
+  const double lnJ = std::log(J);
+  s.P = mu * (F - FinvT) + lambda * lnJ * FinvT;
+  s.S = Finv * s.P;
+  const Mat3 C = F.transpose() * F;
+  s.energy_density = 0.5 * mu * (C.trace() - 3.0) - mu * lnJ + 0.5 * lambda * lnJ * lnJ;
+  // Cauchy stress sigma = (mu (b - I) + lambda ln J I) / J, b = F F^T.
+  const Mat3 sig = (mu * (F * F.transpose() - Mat3::Identity()) + lambda * lnJ * Mat3::Identity()) / J;
+  s.von_mises = von_mises_of(sig);
   return s;
 }
 
@@ -160,7 +194,7 @@ void Solids::update_stress(const Particles& P) {
   parallel_for(X_.size(), [&](std::size_t s) {
     const Mat3 F = deformation_gradient(P, s);
     const SolidParams& sp = params_[material_[s]];
-    const StressState st = svk_stress(F, sp.lambda, sp.mu);
+    const StressState st = stress_of(sp, F);
     F_[s] = F;
     P_[s] = st.P;
     vm_[s] = st.von_mises;
@@ -218,7 +252,7 @@ double Solids::elastic_energy(const Particles& P) const {
       X_.size(), 0.0,
       [&](std::size_t s) {
         const SolidParams& sp = params_[material_[s]];
-        return volume_[s] * svk_stress(deformation_gradient(P, s), sp.lambda, sp.mu).energy_density;
+        return volume_[s] * stress_of(sp, deformation_gradient(P, s)).energy_density;
       },
       [](double a, double b) { return a + b; });
 }

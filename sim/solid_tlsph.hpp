@@ -43,6 +43,7 @@ struct SolidParams {
   double c = 0.0;          // P-wave speed sqrt((lambda + 2 mu) / rho0) [m/s]
   double hourglass = 0.0;  // Ganzenmueller's alpha
   double alpha = 0.0;      // artificial viscosity
+  bool neo_hookean = false;
   explicit SolidParams(const Material& m);
   SolidParams() = default;
 };
@@ -55,6 +56,12 @@ struct StressState {
   double von_mises = 0.0;       // [Pa]
 };
 StressState svk_stress(const Mat3& F, double lambda, double mu);
+// Compressible neo-Hookean (Bonet & Wood 2008, "Nonlinear Continuum Mechanics for Finite Element Analysis",
+// eqs. 6.27-6.28): psi = mu/2 (tr C - 3) - mu ln J + lambda/2 (ln J)^2, P = mu (F - F^-T) + lambda ln J F^-T.
+// The same small-strain limit as eq. (16), but its resistance grows without bound as J -> 0, where Saint
+// Venant-Kirchhoff softens and lets a particle collapse (past a stretch of 1/sqrt(3) in uniaxial
+// compression). J is floored at 0.01 to keep a collapsed particle finite.
+StressState neo_hookean_stress(const Mat3& F, double lambda, double mu);
 
 // All elastic particles of a world. Arrays are indexed by the solid's own index s, which does not change when
 // the particles are re-sorted; at[s] is particle s's current index in Particles (refreshed by reindex()).

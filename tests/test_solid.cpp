@@ -195,6 +195,43 @@ TEST_CASE("TL-SPH patch tests: rigid motions give zero stress, a uniform stretch
   }
 }
 
+TEST_CASE("TL-SPH neo-Hookean: rigid rotation stress-free, uniform stretch analytic, stiffens in compression",
+          "[solid]") {
+  const double dx = 0.01;
+  Particles P = block(7, 7, 7, dx);
+  Material mat = rubber(1e6, 0.3);
+  mat.neo_hookean = true;
+  const CubicSpline K(1.3 * dx);
+  Solids solid(P, {mat}, K, dx, {});
+  const SolidParams sp(mat);
+  REQUIRE(sp.neo_hookean);
+  const Mat3 R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  for (std::size_t i = 0; i < P.size(); ++i) P.x[i] = R * P.x0[i];
+  solid.update_stress(P);
+  for (std::size_t s = 0; s < solid.size(); ++s) CHECK(max_abs(solid.PK1(s)) < 1e-9 * sp.E);
+
+  const Mat3 Fa = Vec3(1.1, 0.95, 1.02).asDiagonal();
+  for (std::size_t i = 0; i < P.size(); ++i) P.x[i] = Fa * P.x0[i];
+  solid.update_stress(P);
+  const double J = Fa.determinant();
+  const Mat3 FinvT = Fa.inverse().transpose();
+  const Mat3 Pa = sp.mu * (Fa - FinvT) + sp.lambda * std::log(J) * FinvT;
+  for (std::size_t s = 0; s < solid.size(); ++s) CHECK(max_abs(solid.PK1(s) - Pa) < 1e-9 * sp.E);
+
+  // Small strain: the same stress as Saint Venant-Kirchhoff (eq. 16) to first order.
+  const Mat3 Fs = Vec3(1.0 + 1e-5, 1.0 - 2e-5, 1.0).asDiagonal();
+  CHECK(max_abs(neo_hookean_stress(Fs, sp.lambda, sp.mu).P - svk_stress(Fs, sp.lambda, sp.mu).P) <
+        1e-3 * max_abs(svk_stress(Fs, sp.lambda, sp.mu).P));
+  // Uniaxial compression to a stretch of 0.4: SVK's axial stress has passed its peak (at 1/sqrt(3)) and
+  // softens; neo-Hookean's keeps growing.
+  auto axial = [&](double l, bool neo) {
+    const Mat3 F = Vec3(l, 1.0, 1.0).asDiagonal();
+    return neo ? neo_hookean_stress(F, sp.lambda, sp.mu).P(0, 0) : svk_stress(F, sp.lambda, sp.mu).P(0, 0);
+  };
+  CHECK(std::abs(axial(0.4, false)) < std::abs(axial(0.6, false)));
+  CHECK(std::abs(axial(0.4, true)) > std::abs(axial(0.6, true)));
+}
+
 TEST_CASE("TL-SPH: internal forces conserve momentum and angular momentum", "[solid][conservation]") {
   const double dx = 0.01;
   Particles P = block(6, 5, 4, dx);
