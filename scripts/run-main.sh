@@ -4,4 +4,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh build
-./build/app/aortasph run scenes/dam_break.json --out out/dam_break "$@"
+./build/app/aortasph run scenes/aortic_root.json --out out/aortic_root "$@"
