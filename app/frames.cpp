@@ -10,14 +10,14 @@ namespace {
 class PipelineSink : public FrameSink {
  public:
   PipelineSink(const Scene& scene, const std::filesystem::path& out_dir)
-      : field_(scene.render.color_by), pipeline_(scene.render, out_dir, scene.output_interval) {}
+      : fields_(scene.render.fields()), pipeline_(scene.render, out_dir, scene.output_interval) {}
 
   // The snapshot is copied here, on the simulation thread; drawing and PNG encoding happen on the render
   // thread.
   void push(const World& world, int frame) override {
     if (pipeline_.failed()) throw InputError("rendering failed: " + pipeline_.error());
     try {
-      pipeline_.push(world.snapshot(field_, frame));
+      pipeline_.push(world.snapshot(fields_, frame));
     } catch (const RenderError& e) {
       throw InputError(std::string("rendering failed: ") + e.what());
     }
@@ -38,6 +38,9 @@ class PipelineSink : public FrameSink {
     }
   }
   std::optional<std::pair<double, double>> field_range() const override { return pipeline_.field_range(); }
+  std::vector<std::optional<std::pair<double, double>>> camera_ranges() const override {
+    return pipeline_.camera_ranges();
+  }
   void adopt_existing_frames(int count) override {
     try {
       pipeline_.adopt_existing_frames(count);
@@ -54,7 +57,7 @@ class PipelineSink : public FrameSink {
   }
 
  private:
-  std::string field_;
+  std::vector<std::string> fields_;  // what the cameras colour by, each once
   FramePipeline pipeline_;
 };
 

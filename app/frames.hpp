@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include "world.hpp"
 
@@ -24,6 +25,8 @@ class FrameSink {
   virtual void flush() = 0;
   // The colour range in use (recorded in checkpoints; empty for color_by material or before one is chosen).
   virtual std::optional<std::pair<double, double>> field_range() const = 0;
+  // The same per camera, in the order of render.cameras (recorded in checkpoints too).
+  virtual std::vector<std::optional<std::pair<double, double>>> camera_ranges() const = 0;
   // Resuming: frames 0 .. count-1 are on disk already (figures read back the ones they need).
   virtual void adopt_existing_frames(int count) = 0;
 };

@@ -187,7 +187,7 @@ uint64_t scene_hash(const nlohmann::json& resolved) {
 }
 
 // What a checkpoint records besides the World: the program version, the resolved scene and the run's
-// options, how many outputs are on disk, and the renderer's colour range.
+// options, how many outputs are on disk, and the renderer's colour ranges (run-wide and per camera).
 struct RunRecord {
   std::string version = AORTASPH_VERSION;
   std::string scene;  // resolved scene JSON
@@ -200,6 +200,9 @@ struct RunRecord {
   double end_override = 0.0, file_end = 0.0;
   int32_t frames = 0;
   std::optional<std::pair<double, double>> range;
+  // Per camera (name, range): cameras may colour by their own field, colormap or hidden bodies (section
+  // "camera_ranges"; a checkpoint without it was written before cameras had overrides).
+  std::vector<std::pair<std::string, std::optional<std::pair<double, double>>>> camera_ranges;
 
   void save(StateWriter& out) const {
     SectionWriter& w = out.section("run", 1);
@@ -219,6 +222,14 @@ struct RunRecord {
     w.value(range.has_value());
     w.value(range ? range->first : 0.0);
     w.value(range ? range->second : 0.0);
+    SectionWriter& c = out.section("camera_ranges", 1);
+    c.value(static_cast<uint64_t>(camera_ranges.size()));
+    for (const auto& [name, r] : camera_ranges) {
+      c.string(name);
+      c.value(r.has_value());
+      c.value(r ? r->first : 0.0);
+      c.value(r ? r->second : 0.0);
+    }
   }
   // The version is read and checked first: a checkpoint of another version is refused before anything of
   // its layout is trusted.
@@ -245,6 +256,18 @@ struct RunRecord {
     const double lo = r.value<double>(), hi = r.value<double>();
     if (has_range) rec.range = std::pair{lo, hi};
     r.done();
+    if (in.has("camera_ranges")) {
+      SectionReader c = in.section("camera_ranges");
+      const auto count = c.value<uint64_t>();
+      for (uint64_t k = 0; k < count; ++k) {
+        std::string name = c.string();
+        const bool has = c.value<bool>();
+        const double clo = c.value<double>(), chi = c.value<double>();
+        rec.camera_ranges.emplace_back(std::move(name),
+                                       has ? std::optional(std::pair{clo, chi}) : std::nullopt);
+      }
+      c.done();
+    }
     if (fnv1a64(rec.scene.data(), rec.scene.size()) != rec.hash)
       throw InputError(file.string() + ": the recorded scene does not match its hash (damaged checkpoint)");
     if (rec.frames < 1) throw InputError(file.string() + ": records no output (damaged checkpoint)");
@@ -289,9 +312,16 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   }
   std::unique_ptr<FrameSink> frames;
   if (!o.no_render) {
-    // The colour range of the interrupted run, so the resumed frames are coloured alike.
+    // The colour ranges of the interrupted run, so the resumed frames are coloured alike: each camera's as
+    // its own range (a camera whose range was not chosen yet must not inherit the run-wide one: it chooses
+    // its own later, as the uninterrupted run does); a checkpoint without per-camera ranges has the run-wide
+    // one only.
     Scene render_scene = scene;
-    if (record && record->range) render_scene.render.range = record->range;
+    if (record && record->camera_ranges.empty() && record->range) render_scene.render.range = record->range;
+    if (record)
+      for (const auto& [name, range] : record->camera_ranges)
+        for (Camera& camera : render_scene.render.cameras)
+          if (camera.name == name && range) camera.range = range;
     frames = make_frame_sink(render_scene, dir);
     if (frames && resume) frames->adopt_existing_frames(first_frame);
   }
@@ -333,6 +363,12 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     if (frames) frames->flush();
     rec.frames = frame;
     rec.range = frames ? frames->field_range() : std::nullopt;
+    rec.camera_ranges.clear();
+    if (frames) {
+      const auto ranges = frames->camera_ranges();
+      for (std::size_t c = 0; c < ranges.size() && c < scene.render.cameras.size(); ++c)
+        rec.camera_ranges.emplace_back(scene.render.cameras[c].name, ranges[c]);
+    }
     StateWriter out;
     rec.save(out);
     world.save_state(out);

@@ -684,6 +684,16 @@ class Loader {
     return p;
   }
 
+  // [low, high] with low < high (a colour range).
+  static std::pair<double, double> color_range(Obj& o, const std::string& key) {
+    const json& v = o.raw(key);
+    if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
+      fail(o.path(key), "expected two numbers [low, high]");
+    const std::pair<double, double> r{v[0].get<double>(), v[1].get<double>()};
+    if (!(r.first < r.second)) fail(o.path(key), "low must be below high");
+    return r;
+  }
+
   void render(json& j, Scene& s) {
     Obj o(j, "render",
           {"width", "height", "background", "color_by", "colormap", "range", "cameras", "clip", "figures"},
@@ -695,21 +705,17 @@ class Loader {
       fail(o.path(r.width % 2 ? "width" : "height"), "must be even (movies need even sizes)");
     if (!o.has("background")) j["background"] = {1.0, 1.0, 1.0};
     r.background = o.color("background");
-    r.color_by =
-        o.choice("color_by", {"material", "speed", "pressure", "displacement", "stress"}, "material");
+    const std::vector<std::string> fields = {"material", "speed", "pressure", "displacement", "stress"};
+    r.color_by = o.choice("color_by", fields, "material");
     r.colormap = o.string("colormap", "viridis");
-    if (o.has("range")) {
-      const json& v = o.raw("range");
-      if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
-        fail(o.path("range"), "expected two numbers [low, high]");
-      r.range = std::pair{v[0].get<double>(), v[1].get<double>()};
-      if (!(r.range->first < r.range->second)) fail(o.path("range"), "low must be below high");
-    }
+    if (o.has("range")) r.range = color_range(o, "range");
     if (!o.has("cameras")) j["cameras"] = json::array();
     json& cams = o.raw("cameras");
     if (!cams.is_array()) fail(o.path("cameras"), "expected a list, got " + type_name(cams));
     for (std::size_t c = 0; c < cams.size(); ++c) {
-      Obj co(cams[c], index("render.cameras", c), {"name", "eye", "target", "up", "fov_deg"}, allowed);
+      Obj co(cams[c], index("render.cameras", c),
+             {"name", "eye", "target", "up", "fov_deg", "color_by", "colormap", "range", "hide", "clip"},
+             allowed);
       Camera cam;
       cam.name = co.string("name");
       if (cam.name.empty() || cam.name.find('/') != std::string::npos)
@@ -724,6 +730,17 @@ class Loader {
       if ((cam.eye - cam.target).norm() < 1e-12) fail(co.path("target"), "must differ from eye");
       if ((cam.eye - cam.target).normalized().cross(cam.up).norm() < 1e-6)
         fail(co.path("up"), "is parallel to the viewing direction");
+      // Overrides of the run-wide settings; absent keys are not filled in (absent = the run-wide value, so
+      // that --set render.color_by=... still reaches every camera that does not set its own).
+      if (co.has("color_by")) cam.color_by = co.choice("color_by", fields);
+      if (co.has("colormap")) cam.colormap = co.string("colormap");  // the renderer checks the name
+      if (co.has("range")) cam.range = color_range(co, "range");
+      if (co.has("hide")) {
+        const auto names = co.strings("hide");
+        for (std::size_t k = 0; k < names.size(); ++k)
+          cam.hide.push_back(body_index(s, names[k], index(co.path("hide"), k)));
+      }
+      if (co.has("clip")) cam.clip = co.boolean("clip", true);
       r.cameras.push_back(cam);
     }
     if (o.has("clip")) {

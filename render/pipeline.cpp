@@ -133,12 +133,18 @@ void FramePipeline::thread_main(std::promise<void>* ready) {
       // Popped only after the frame is written, so the queue bound also counts the frame in hand.
       std::lock_guard lock(mutex_);
       if (!queue_.empty()) queue_.pop_front();
-      range_ = renderer->field_range();
+      record_ranges(*renderer);
     }
     changed_.notify_all();
   }
   std::lock_guard lock(mutex_);
-  range_ = renderer->field_range();
+  record_ranges(*renderer);
+}
+
+void FramePipeline::record_ranges(const Renderer& renderer) {
+  range_ = renderer.field_range();
+  camera_ranges_.clear();
+  for (const Camera& camera : settings_.cameras) camera_ranges_.push_back(renderer.field_range(camera));
 }
 
 void FramePipeline::flush() {
@@ -150,6 +156,11 @@ void FramePipeline::flush() {
 std::optional<std::pair<double, double>> FramePipeline::field_range() const {
   std::lock_guard lock(mutex_);
   return range_;
+}
+
+std::vector<std::optional<std::pair<double, double>>> FramePipeline::camera_ranges() const {
+  std::lock_guard lock(mutex_);
+  return camera_ranges_;
 }
 
 void FramePipeline::adopt_existing_frames(int count) {
@@ -165,10 +176,7 @@ void FramePipeline::adopt_existing_frames(int count) {
 }
 
 void FramePipeline::render_one(Renderer& renderer, const Snapshot& snapshot) {
-  if (!snapshot.field_name.empty()) {
-    field_name_ = snapshot.field_name;
-    field_unit_ = snapshot.field_unit;
-  }
+  for (const SnapshotField& field : snapshot.fields) units_[field.name] = field.unit;
   char name[32];
   std::snprintf(name, sizeof name, "frame_%05d.png", snapshot.frame);
   for (const Camera& camera : settings_.cameras) {
@@ -208,11 +216,18 @@ void FramePipeline::write_figures() {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw RenderError("cannot create " + dir.string() + ": " + ec.message());
-  std::optional<ColorBar> bar;
-  if (settings_.color_by != "material" && range_)
-    bar = ColorBar{settings_.colormap, range_->first, range_->second,
-                   field_name_.empty() ? settings_.color_by : field_name_, field_unit_};
   for (const Figure& fig : settings_.figures) {
+    // The colour bar of the figure's camera: its field, colormap and range.
+    std::optional<ColorBar> bar;
+    for (std::size_t c = 0; c < settings_.cameras.size() && c < camera_ranges_.size(); ++c) {
+      const Camera& camera = settings_.cameras[c];
+      const std::string& field = settings_.color_by_of(camera);
+      if (camera.name != fig.camera || field == "material" || !camera_ranges_[c]) continue;
+      const std::pair<double, double>& range = *camera_ranges_[c];
+      const auto unit = units_.find(field);
+      bar = ColorBar{settings_.colormap_of(camera), range.first, range.second, field,
+                     unit != units_.end() ? unit->second : std::string()};
+    }
     std::vector<FigurePanel> panels;
     for (double t : fig.times) {
       const int frame = static_cast<int>(std::lround(t / output_interval_));

@@ -56,6 +56,9 @@ class FramePipeline {
   // The colour range chosen so far (settings.range or the one picked from the first non-constant field);
   // a resumed run passes it back in settings.range so its frames keep the same colours.
   std::optional<std::pair<double, double>> field_range() const;
+  // The same per camera (Renderer::field_range(camera)), in the order of settings.cameras; a resumed run
+  // passes them back as the cameras' own ranges.
+  std::vector<std::optional<std::pair<double, double>>> camera_ranges() const;
   // Resuming: frames 0 .. count-1 are already on disk; the ones that figures need are read back from
   // out_dir/frames/<camera>/. Call before the first push(). Throws RenderError when such a frame is missing.
   void adopt_existing_frames(int count);
@@ -70,6 +73,7 @@ class FramePipeline {
   void render_one(Renderer& renderer, const Snapshot& snapshot);
   void fail(const std::string& message);
   void write_figures();
+  void record_ranges(const Renderer& renderer);  // called with mutex_ held
 
   RenderSettings settings_;
   std::filesystem::path out_dir_;
@@ -90,7 +94,8 @@ class FramePipeline {
       panels_;                                      // (camera, frame) -> (time, image)
   std::map<std::string, std::vector<int>> wanted_;  // camera -> frames for figures
   std::optional<std::pair<double, double>> range_;  // guarded by mutex_ while the thread runs
-  std::string field_name_, field_unit_;
+  std::vector<std::optional<std::pair<double, double>>> camera_ranges_;  // the same, per camera
+  std::map<std::string, std::string> units_;                             // field name -> unit
 };
 
 }  // namespace aortasph

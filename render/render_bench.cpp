@@ -26,8 +26,9 @@ RenderBenchResult bench_render(std::ostream& out, int particles, int frames) {
   const int nx = static_cast<int>(std::ceil(1.0 / spacing)), ny = static_cast<int>(std::ceil(0.5 / spacing));
   Snapshot snap;
   snap.spacing = spacing;
-  snap.field_name = "speed";
-  snap.field_unit = "m/s";
+  SnapshotField& speed = snap.fields.emplace_back();
+  speed.name = "speed";
+  speed.unit = "m/s";
   BodyView water;
   water.name = "water";
   snap.bodies.push_back(water);
@@ -37,7 +38,7 @@ RenderBenchResult bench_render(std::ostream& out, int particles, int frames) {
                          {static_cast<float>((x + 0.5) * spacing), static_cast<float>((y + 0.5) * spacing),
                           static_cast<float>((z + 0.5) * spacing)});
     snap.body.push_back(0);
-    snap.field.push_back(static_cast<float>(2.0 * y * spacing + std::sin(10.0 * x * spacing)));
+    speed.values.push_back(static_cast<float>(2.0 * y * spacing + std::sin(10.0 * x * spacing)));
   }
 
   Renderer renderer(settings);

@@ -10,6 +10,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <limits>
+#include <map>
+#include <tuple>
 
 #include "colormap.hpp"
 #include "embedded_shaders.hpp"
@@ -40,6 +42,34 @@ struct SplatVertex {
 bool diverging(const std::string& colormap) {
   return colormap == "coolwarm";
 }
+
+bool valid_range(const std::pair<double, double>& r) {
+  return r.first < r.second && std::isfinite(r.first) && std::isfinite(r.second);
+}
+
+// What one camera draws with (RenderSettings::*_of): its field, colormap, fixed range, hidden bodies, clip.
+struct Look {
+  const std::string& color_by;
+  const std::string& colormap;
+  std::optional<std::pair<double, double>> range;
+  std::vector<int> hide;  // sorted, unique
+  const Clip* clip;
+  Look(const RenderSettings& s, const Camera& c)
+      : color_by(s.color_by_of(c)),
+        colormap(s.colormap_of(c)),
+        range(s.range_of(c)),
+        hide(c.hide),
+        clip(s.clip_of(c)) {
+    std::sort(hide.begin(), hide.end());
+    hide.erase(std::unique(hide.begin(), hide.end()), hide.end());
+  }
+  bool hides(std::size_t b) const {
+    return std::binary_search(hide.begin(), hide.end(), static_cast<int>(b));
+  }
+};
+
+// Cameras that colour alike share a range chosen at run time: same field, colormap and hidden bodies.
+using RangeKey = std::tuple<std::string, std::string, std::vector<int>>;
 
 }  // namespace
 
@@ -76,17 +106,28 @@ void validate_render_settings(const RenderSettings& s) {
       throw RenderError("render.background: components must be in [0, 1], got " + vec_str(s.background));
   Colormap check(s.colormap);  // throws for an unknown name
   if (s.color_by.empty()) throw RenderError("render.color_by: empty");
-  if (s.range &&
-      !(s.range->first < s.range->second && std::isfinite(s.range->first) && std::isfinite(s.range->second)))
+  if (s.range && !valid_range(*s.range))
     throw RenderError("render.range: expected [min, max] with min < max");
   if (s.clip && !(s.clip->normal.norm() > 0.0)) throw RenderError("render.clip.normal: zero vector");
-  for (const Camera& camera : s.cameras) validate_camera(camera);
+  for (std::size_t c = 0; c < s.cameras.size(); ++c) {
+    const Camera& camera = s.cameras[c];
+    validate_camera(camera);
+    const std::string at = "render.cameras[" + std::to_string(c) + "].";
+    if (camera.colormap) {
+      const auto names = Colormap::names();
+      if (std::find(names.begin(), names.end(), *camera.colormap) == names.end())
+        throw RenderError(at + "colormap: unknown colormap \"" + *camera.colormap +
+                          "\" (known: viridis, coolwarm)");
+    }
+    if (camera.color_by && camera.color_by->empty()) throw RenderError(at + "color_by: empty");
+    if (camera.range && !valid_range(*camera.range))
+      throw RenderError(at + "range: expected [min, max] with min < max");
+  }
 }
 
 struct Renderer::Impl {
   RenderSettings settings;
-  Colormap colormap;
-  std::optional<std::pair<double, double>> range;
+  std::map<RangeKey, std::pair<double, double>> ranges;  // chosen at run time, kept for the run
   GlContext context;
   GLuint splat_program = 0, mesh_program = 0;
   GLuint splat_vao = 0, mesh_vao = 0, splat_vbo = 0, mesh_vbo = 0, mesh_ebo = 0;
@@ -95,7 +136,7 @@ struct Renderer::Impl {
   std::vector<SplatVertex> splats;  // reused between frames
   std::vector<uint8_t> rows;        // read-back buffer, reused
 
-  explicit Impl(const RenderSettings& s) : settings(s), colormap(s.colormap), range(s.range) {
+  explicit Impl(const RenderSettings& s) : settings(s) {
     splat_program = build_program("shaders/splat.vert.glsl", shaders::splat_vert_glsl,
                                   "shaders/splat.frag.glsl", shaders::splat_frag_glsl);
     mesh_program = build_program("shaders/mesh.vert.glsl", shaders::mesh_vert_glsl, "shaders/mesh.frag.glsl",
@@ -172,66 +213,85 @@ struct Renderer::Impl {
     glDeleteRenderbuffers(3, rbs);
   }
 
-  bool use_field(const Snapshot& snap) const {
-    return settings.color_by != "material" && !snap.field.empty();
+  // The field a camera colours by, or nullptr for body colours (color_by "material", or a snapshot without
+  // that field's values).
+  static const SnapshotField* field_of(const Snapshot& snap, const Look& look) {
+    if (look.color_by == "material") return nullptr;
+    const SnapshotField* f = snap.field(look.color_by);
+    return f && !f->values.empty() ? f : nullptr;
   }
 
-  // The run's range is fixed at the first snapshot whose (drawn) field is not constant. Fields that never go
-  // negative (speed, stress, displacement) start at 0; diverging maps get a range symmetric about 0 so that
-  // the neutral colour means zero.
-  void choose_range(const Snapshot& snap) {
-    if (range || !use_field(snap)) return;
+  static RangeKey key_of(const Look& look) { return {look.color_by, look.colormap, look.hide}; }
+
+  // The camera's range: its fixed one, or the one chosen for its kind of look; empty for body colours.
+  std::optional<std::pair<double, double>> range_of(const Look& look) const {
+    if (look.color_by == "material") return std::nullopt;
+    if (look.range) return look.range;
+    const auto it = ranges.find(key_of(look));
+    if (it == ranges.end()) return std::nullopt;
+    return it->second;
+  }
+
+  // Without a fixed range, the range is chosen at the first snapshot whose field, over the particles the
+  // camera draws (clip aside), is not constant, and kept for the run. Fields that never go negative (speed,
+  // stress, displacement) start at 0; diverging maps get a range symmetric about 0 so that the neutral
+  // colour means zero.
+  void choose_range(const Snapshot& snap, const Look& look, const SnapshotField* field) {
+    if (!field || look.range || ranges.count(key_of(look))) return;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (size_t i = 0; i < snap.size(); ++i) {
       const int b = snap.body[i];
-      if (b >= static_cast<int>(snap.bodies.size()) || snap.bodies[b].render != RenderMode::Particles)
+      if (b >= static_cast<int>(snap.bodies.size()) || snap.bodies[b].render != RenderMode::Particles ||
+          look.hides(b))
         continue;
-      const double v = snap.field[i];
+      const double v = field->values[i];
       if (!std::isfinite(v)) continue;
       lo = std::min(lo, v);
       hi = std::max(hi, v);
     }
     if (!(hi > lo)) return;
-    if (diverging(settings.colormap)) {
+    if (diverging(look.colormap)) {
       const double m = std::max(std::abs(lo), std::abs(hi));
-      range = {-m, m};
+      ranges[key_of(look)] = {-m, m};
     } else {
-      range = {std::min(lo, 0.0), hi};
+      ranges[key_of(look)] = {std::min(lo, 0.0), hi};
     }
   }
 
   // Array sizes first: everything after indexes by particle.
-  static void check_sizes(const Snapshot& snap, bool field) {
+  static void check_sizes(const Snapshot& snap, const SnapshotField* field) {
     const size_t n = snap.size();
     if (snap.position.size() != 3 * n)
       throw RenderError("snapshot: " + std::to_string(snap.position.size()) + " coordinates for " +
                         std::to_string(n) + " particles");
-    if (field && snap.field.size() != n)
-      throw RenderError("snapshot: field \"" + snap.field_name + "\" has " +
-                        std::to_string(snap.field.size()) + " values for " + std::to_string(n) +
+    if (field && field->values.size() != n)
+      throw RenderError("snapshot: field \"" + field->name + "\" has " +
+                        std::to_string(field->values.size()) + " values for " + std::to_string(n) +
                         " particles");
   }
 
-  void build_splats(const Snapshot& snap) {
+  void build_splats(const Snapshot& snap, const Look& look, const SnapshotField* field) {
     const size_t n = snap.size();
-    const bool field = use_field(snap);
     const size_t nb = snap.bodies.size();
     std::vector<uint8_t> draw(nb, 0), clipped(nb, 0);
     std::vector<std::array<uint8_t, 4>> body_color(nb);
     for (size_t b = 0; b < nb; ++b) {
-      draw[b] = snap.bodies[b].render == RenderMode::Particles;
+      draw[b] = snap.bodies[b].render == RenderMode::Particles && !look.hides(b);
       for (int c = 0; c < 3; ++c)
         body_color[b][c] =
             static_cast<uint8_t>(std::lround(std::clamp(snap.bodies[b].color[c], 0.0f, 1.0f) * 255.0f));
       body_color[b][3] = 255;
     }
     glm::dvec3 clip_n(0.0), clip_p(0.0);
-    if (settings.clip) {
-      clip_n = glm::normalize(to_glm(settings.clip->normal));
-      clip_p = to_glm(settings.clip->point);
-      for (int b : settings.clip->bodies)
+    if (look.clip) {
+      clip_n = glm::normalize(to_glm(look.clip->normal));
+      clip_p = to_glm(look.clip->point);
+      for (int b : look.clip->bodies)
         if (b >= 0 && static_cast<size_t>(b) < nb) clipped[b] = 1;
     }
+    const auto range = range_of(look);
+    std::optional<Colormap> colormap;
+    if (field) colormap.emplace(look.colormap);
     const double lo = range ? range->first : 0.0;
     const double inv = range ? 1.0 / (range->second - range->first) : 0.0;
     splats.clear();
@@ -250,7 +310,7 @@ struct Renderer::Impl {
       std::memcpy(v.position, p, sizeof v.position);
       if (field) {
         // Before a range exists (constant field so far) every value maps to the bottom of the map.
-        const auto c = colormap((snap.field[i] - lo) * inv);
+        const auto c = (*colormap)((field->values[i] - lo) * inv);
         v.color[0] = c[0];
         v.color[1] = c[1];
         v.color[2] = c[2];
@@ -263,7 +323,8 @@ struct Renderer::Impl {
   }
 
   // Near and far planes enclosing everything drawn, so depth precision follows the scene's scale.
-  std::pair<double, double> depth_bounds(const Snapshot& snap, const glm::dvec3& eye, const glm::dvec3& dir) {
+  std::pair<double, double> depth_bounds(const Snapshot& snap, const Look& look, const glm::dvec3& eye,
+                                         const glm::dvec3& dir) {
     double dmin = std::numeric_limits<double>::infinity(), dmax = -dmin;
     auto add = [&](const float* p) {
       const double d = (p[0] - eye.x) * dir.x + (p[1] - eye.y) * dir.y + (p[2] - eye.z) * dir.z;
@@ -271,9 +332,9 @@ struct Renderer::Impl {
       dmax = std::max(dmax, d);
     };
     for (const SplatVertex& v : splats) add(v.position);
-    for (const BodyView& body : snap.bodies)
-      if (body.render == RenderMode::Surface)
-        for (const auto& p : body.mesh.vertices) add(p.data());
+    for (size_t b = 0; b < snap.bodies.size(); ++b)
+      if (snap.bodies[b].render == RenderMode::Surface && !look.hides(b))
+        for (const auto& p : snap.bodies[b].mesh.vertices) add(p.data());
     const double margin = snap.spacing + 1e-6;
     if (!(dmax > 0.0)) return {0.01, 1.0};  // nothing in front of the camera
     const double far = dmax + margin;
@@ -284,14 +345,16 @@ struct Renderer::Impl {
   Image render(const Snapshot& snap, const Camera& camera) {
     validate_camera(camera);
     context.make_current();
-    check_sizes(snap, use_field(snap));
-    choose_range(snap);
-    build_splats(snap);
+    const Look look(settings, camera);
+    const SnapshotField* field = field_of(snap, look);
+    check_sizes(snap, field);
+    choose_range(snap, look, field);
+    build_splats(snap, look, field);
 
     const int w = settings.width, h = settings.height;
     const glm::dvec3 eye = to_glm(camera.eye), target = to_glm(camera.target);
     const glm::dvec3 dir = glm::normalize(target - eye);
-    const auto [near, far] = depth_bounds(snap, eye, dir);
+    const auto [near, far] = depth_bounds(snap, look, eye, dir);
     const glm::mat4 view = glm::mat4(glm::lookAt(eye, target, to_glm(camera.up)));
     const glm::mat4 proj =
         glm::mat4(glm::perspective(glm::radians(camera.fov_deg), static_cast<double>(w) / h, near, far));
@@ -334,8 +397,9 @@ struct Renderer::Impl {
     // Translucent surfaces after the opaque splats, without depth writes, so particles behind a wall show
     // through it and overlapping wall layers all contribute.
     bool any_mesh = false;
-    for (const BodyView& body : snap.bodies)
-      any_mesh |= body.render == RenderMode::Surface && !body.mesh.empty();
+    for (size_t b = 0; b < snap.bodies.size(); ++b)
+      any_mesh |=
+          snap.bodies[b].render == RenderMode::Surface && !snap.bodies[b].mesh.empty() && !look.hides(b);
     if (any_mesh) {
       glUseProgram(mesh_program);
       glUniformMatrix4fv(glGetUniformLocation(mesh_program, "u_view"), 1, GL_FALSE, glm::value_ptr(view));
@@ -345,9 +409,9 @@ struct Renderer::Impl {
       glUniform1f(glGetUniformLocation(mesh_program, "u_diffuse"), Lighting::kDiffuse);
       glUniform1f(glGetUniformLocation(mesh_program, "u_alpha"), Lighting::kMeshAlpha);
       glm::vec4 plane(0.0f);
-      if (settings.clip) {
-        const glm::dvec3 n = glm::normalize(to_glm(settings.clip->normal));
-        plane = glm::vec4(glm::vec3(n), static_cast<float>(-glm::dot(n, to_glm(settings.clip->point))));
+      if (look.clip) {
+        const glm::dvec3 n = glm::normalize(to_glm(look.clip->normal));
+        plane = glm::vec4(glm::vec3(n), static_cast<float>(-glm::dot(n, to_glm(look.clip->point))));
       }
       glUniform4fv(glGetUniformLocation(mesh_program, "u_clip_plane"), 1, glm::value_ptr(plane));
       glBindVertexArray(mesh_vao);
@@ -359,13 +423,13 @@ struct Renderer::Impl {
       glDisable(GL_CULL_FACE);
       for (size_t b = 0; b < snap.bodies.size(); ++b) {
         const BodyView& body = snap.bodies[b];
-        if (body.render != RenderMode::Surface || body.mesh.empty()) continue;
+        if (body.render != RenderMode::Surface || body.mesh.empty() || look.hides(b)) continue;
         const size_t nv = body.mesh.vertices.size();
         for (const auto& t : body.mesh.triangles)
           if (t[0] >= nv || t[1] >= nv || t[2] >= nv)
             throw RenderError("snapshot: mesh of body \"" + body.name + "\" indexes a missing vertex");
-        const bool clip = settings.clip && std::count(settings.clip->bodies.begin(),
-                                                      settings.clip->bodies.end(), static_cast<int>(b)) > 0;
+        const bool clip = look.clip && std::count(look.clip->bodies.begin(), look.clip->bodies.end(),
+                                                  static_cast<int>(b)) > 0;
         if (clip)
           glEnable(GL_CLIP_DISTANCE0);
         else
@@ -425,8 +489,11 @@ Image Renderer::render(const Snapshot& snapshot, const Camera& camera) {
 }
 
 std::optional<std::pair<double, double>> Renderer::field_range() const {
-  if (impl_->settings.color_by == "material") return std::nullopt;
-  return impl_->range;
+  return field_range(Camera{});
+}
+
+std::optional<std::pair<double, double>> Renderer::field_range(const Camera& camera) const {
+  return impl_->range_of(Look(impl_->settings, camera));
 }
 
 const RenderSettings& Renderer::settings() const {

@@ -2,10 +2,12 @@
 //
 // Particles are lit sphere impostors (GL_POINTS, radius = spacing / 2, true depth); bodies with
 // render == Surface are drawn as their translucent, two-sided lit mesh instead of their particles; Hidden
-// bodies are not drawn. Colour is the body colour (color_by == "material") or the snapshot's field through
-// the colormap, with one range for the whole run. The clip plane removes the +normal half of the listed
-// bodies. Anti-aliasing: a 4x multisampled framebuffer with alpha-to-coverage on the splat rims (smooth
-// silhouettes without shading every sample; llvmpipe offers at most 4 samples).
+// bodies, and the bodies a camera hides, are not drawn. Colour is the body colour (color_by == "material")
+// or the snapshot's field through the colormap, with one range for the whole run. The clip plane removes
+// the +normal half of the listed bodies. Each camera may override color_by, colormap, range, hide and clip
+// (scene.hpp Camera; RenderSettings::*_of say what applies). Anti-aliasing: a 4x multisampled framebuffer
+// with alpha-to-coverage on the splat rims (smooth silhouettes without shading every sample; llvmpipe offers
+// at most 4 samples).
 #pragma once
 
 #include <memory>
@@ -41,7 +43,8 @@ int msaa_samples();
 void validate_camera(const Camera& camera);
 
 // Throws RenderError for: width/height not positive and even (or above 16384), an unknown colormap, a
-// background outside [0, 1], an inverted or empty range, a zero clip normal, an invalid camera.
+// background outside [0, 1], an inverted or empty range, a zero clip normal, an invalid camera (also its
+// own colormap, color_by or range).
 void validate_render_settings(const RenderSettings& settings);
 
 class Renderer {
@@ -57,10 +60,14 @@ class Renderer {
   // inconsistent snapshot (field or body index sizes).
   Image render(const Snapshot& snapshot, const Camera& camera);
 
-  // The colour range in use: settings().range, or the one chosen from the first snapshot whose field is not
-  // constant (then kept for the rest of the run). Empty while none has been chosen or for color_by
-  // "material".
+  // The colour range in use for cameras without overrides: settings().range, or the one chosen from the
+  // first snapshot whose field is not constant (then kept for the rest of the run). Empty while none has
+  // been chosen or for color_by "material".
   std::optional<std::pair<double, double>> field_range() const;
+  // The same for one camera: its own range, settings().range when it colours by the run's field, or the one
+  // chosen from the particles it draws. Cameras with the same field, colormap and hidden bodies share the
+  // chosen range.
+  std::optional<std::pair<double, double>> field_range(const Camera& camera) const;
 
   const RenderSettings& settings() const;
   std::string gl_renderer() const;

@@ -4,9 +4,11 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <array>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace aortasph {
@@ -180,6 +182,13 @@ struct Camera {
   Vec3 target = Vec3::Zero();
   Vec3 up = Vec3::UnitY();
   double fov_deg = 35.0;
+  // Optional per-camera overrides of the run-wide render settings, for this camera's frames and the figures
+  // drawn from it (docs/scenes.md). Unset: the run-wide value (RenderSettings::*_of below).
+  std::optional<std::string> color_by;
+  std::optional<std::string> colormap;
+  std::optional<std::pair<double, double>> range;
+  std::vector<int> hide;  // bodies this camera does not draw (indices into Scene::bodies)
+  bool clip = true;       // false: render.clip does not apply to this camera
 };
 
 struct Figure {
@@ -205,6 +214,26 @@ struct RenderSettings {
   std::vector<Camera> cameras;
   std::optional<Clip> clip;
   std::vector<Figure> figures;
+
+  // What a camera draws with: its own setting where it has one, else the run-wide one. A camera inherits
+  // `range` only when it colours by the run's field (a range in m/s means nothing for a stress in Pa); else
+  // its range is chosen from the particles it draws.
+  const std::string& color_by_of(const Camera& c) const { return c.color_by ? *c.color_by : color_by; }
+  const std::string& colormap_of(const Camera& c) const { return c.colormap ? *c.colormap : colormap; }
+  std::optional<std::pair<double, double>> range_of(const Camera& c) const {
+    if (c.range) return c.range;
+    return color_by_of(c) == color_by ? range : std::nullopt;
+  }
+  const Clip* clip_of(const Camera& c) const { return c.clip && clip ? &*clip : nullptr; }
+  // The fields the cameras colour by, each once, in camera order ("material" is not a field).
+  std::vector<std::string> fields() const {
+    std::vector<std::string> out;
+    for (const Camera& c : cameras) {
+      const std::string& f = color_by_of(c);
+      if (f != "material" && std::find(out.begin(), out.end(), f) == out.end()) out.push_back(f);
+    }
+    return out;
+  }
 };
 
 struct Scene {

@@ -26,17 +26,28 @@ struct BodyView {
   SurfaceMesh mesh;  // in world coordinates at this snapshot's time (may be empty)
 };
 
+// One per-particle field a camera colours by.
+struct SnapshotField {
+  std::string name;           // e.g. "speed"
+  std::string unit;           // e.g. "m/s"
+  std::vector<float> values;  // n values
+};
+
 struct Snapshot {
   double time = 0.0;
-  int frame = 0;                // output index k: time = k * output_interval
-  double spacing = 0.01;        // particle spacing: splat radius = spacing / 2
-  std::vector<float> position;  // 3 * n, xyz per particle
-  std::vector<uint16_t> body;   // body index per particle (index into bodies)
-  std::vector<float> field;     // n values of render.color_by (empty when color_by == "material")
-  std::string field_name;       // e.g. "speed"
-  std::string field_unit;       // e.g. "m/s"
+  int frame = 0;                      // output index k: time = k * output_interval
+  double spacing = 0.01;              // particle spacing: splat radius = spacing / 2
+  std::vector<float> position;        // 3 * n, xyz per particle
+  std::vector<uint16_t> body;         // body index per particle (index into bodies)
+  std::vector<SnapshotField> fields;  // each field some camera colours by, once (none for "material")
   std::vector<BodyView> bodies;
   size_t size() const { return body.size(); }
+  // The field of that name, or nullptr.
+  const SnapshotField* field(const std::string& name) const {
+    for (const SnapshotField& f : fields)
+      if (f.name == name) return &f;
+    return nullptr;
+  }
 };
 
 }  // namespace aortasph

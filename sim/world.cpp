@@ -640,6 +640,10 @@ void World::load_state(const StateReader& in) {
 }
 
 Snapshot World::snapshot(const std::string& field, int frame) const {
+  return snapshot(std::vector<std::string>{field}, frame);
+}
+
+Snapshot World::snapshot(const std::vector<std::string>& fields, int frame) const {
   Snapshot s;
   s.time = time_;
   s.frame = frame;
@@ -651,22 +655,25 @@ Snapshot World::snapshot(const std::string& field, int frame) const {
     for (int d = 0; d < 3; ++d) s.position[3 * i + d] = static_cast<float>(P_.x[i][d]);
     s.body[i] = P_.body[i];
   }
-  if (field != "material") {
-    s.field_name = field;
-    s.field.resize(n, 0.0f);
+  // Each distinct field once, in the order asked.
+  for (const std::string& field : fields) {
+    if (field == "material" || s.field(field)) continue;
+    SnapshotField& f = s.fields.emplace_back();
+    f.name = field;
+    f.values.resize(n, 0.0f);
     if (field == "speed") {
-      s.field_unit = "m/s";
-      for (std::size_t i = 0; i < n; ++i) s.field[i] = static_cast<float>(P_.v[i].norm());
+      f.unit = "m/s";
+      for (std::size_t i = 0; i < n; ++i) f.values[i] = static_cast<float>(P_.v[i].norm());
     } else if (field == "pressure") {
-      s.field_unit = "Pa";
-      for (std::size_t i = 0; i < n; ++i) s.field[i] = static_cast<float>(P_.p[i]);
+      f.unit = "Pa";
+      for (std::size_t i = 0; i < n; ++i) f.values[i] = static_cast<float>(P_.p[i]);
     } else if (field == "displacement") {
-      s.field_unit = "m";
-      for (std::size_t i = 0; i < n; ++i) s.field[i] = static_cast<float>((P_.x[i] - P_.x0[i]).norm());
+      f.unit = "m";
+      for (std::size_t i = 0; i < n; ++i) f.values[i] = static_cast<float>((P_.x[i] - P_.x0[i]).norm());
     } else if (field == "stress") {
-      s.field_unit = "Pa";  // von Mises stress of elastic particles; zero elsewhere
+      f.unit = "Pa";  // von Mises stress of elastic particles; zero elsewhere
       for (std::size_t k = 0; k < solids_.size(); ++k)
-        s.field[solids_.at(k)] = static_cast<float>(solids_.von_mises(k));
+        f.values[solids_.at(k)] = static_cast<float>(solids_.von_mises(k));
     }
   }
   for (std::size_t b = 0; b < bodies_.size(); ++b) {

@@ -148,8 +148,10 @@ class World {
   void save_state(StateWriter& out) const;
   void load_state(const StateReader& in);
 
-  // What the renderer needs; field is one of material, speed, pressure, displacement, stress.
-  Snapshot snapshot(const std::string& field, int frame) const;
+  // What the renderer needs, with each of `fields` (material, speed, pressure, displacement, stress)
+  // computed once; "material" and repeats add nothing.
+  Snapshot snapshot(const std::vector<std::string>& fields, int frame) const;
+  Snapshot snapshot(const std::string& field, int frame) const;  // one field
 
  private:
   void update_neighbors();

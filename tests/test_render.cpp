@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <numbers>
 
 #include "colormap.hpp"
@@ -112,13 +113,12 @@ SurfaceMesh square(float z0, float half = 1.0f) {
 Snapshot strip(int n) {
   Snapshot s;
   s.spacing = 2.0 / n;
-  s.field_name = "speed";
-  s.field_unit = "m/s";
+  s.fields.push_back({"speed", "m/s", {}});
   s.bodies.push_back(body("strip", {1, 1, 1}));
   for (int i = 0; i < n; ++i) {
     s.position.insert(s.position.end(), {static_cast<float>(-1.0 + (i + 0.5) * s.spacing), 0.0f, 0.0f});
     s.body.push_back(0);
-    s.field.push_back(static_cast<float>(i) / (n - 1));
+    s.fields[0].values.push_back(static_cast<float>(i) / (n - 1));
   }
   return s;
 }
@@ -321,15 +321,15 @@ TEST_CASE("render: the field range is chosen once, from the first non-constant f
   settings.color_by = "speed";
   Renderer renderer(settings);
   Snapshot snap = strip(4);
-  snap.field = {0, 0, 0, 0};
+  snap.fields[0].values = {0, 0, 0, 0};
   renderer.render(snap, front_camera());
   CHECK_FALSE(renderer.field_range().has_value());
-  snap.field = {0.5f, 1, 2, 3};
+  snap.fields[0].values = {0.5f, 1, 2, 3};
   renderer.render(snap, front_camera());
   REQUIRE(renderer.field_range().has_value());
   CHECK(renderer.field_range()->first == 0.0);  // speeds start at 0
   CHECK(renderer.field_range()->second == 3.0);
-  snap.field = {0, 10, 20, 30};
+  snap.fields[0].values = {0, 10, 20, 30};
   renderer.render(snap, front_camera());
   CHECK(renderer.field_range()->second == 3.0);  // kept for the whole run
 }
@@ -370,7 +370,7 @@ TEST_CASE("render: bad input raises RenderError with a clear message", "[render]
   by_speed.color_by = "speed";
   Renderer speed_renderer(by_speed);
   Snapshot short_field = strip(4);
-  short_field.field.pop_back();
+  short_field.fields[0].values.pop_back();
   CHECK_THAT(message_of([&] { speed_renderer.render(short_field, front_camera()); }),
              Catch::Contains("3 values for 4 particles"));
 
@@ -412,7 +412,7 @@ TEST_CASE("render: frame pipeline writes numbered frames and an even-sized figur
       Snapshot s = strip(12);
       s.frame = k;
       s.time = 0.1 * k;
-      for (float& v : s.field) v *= static_cast<float>(k + 1);
+      for (float& v : s.fields[0].values) v *= static_cast<float>(k + 1);
       pipeline.push(std::move(s));
     }
     pipeline.finish();
@@ -556,4 +556,261 @@ TEST_CASE("render: a short scene run gives identical frames for 1 and 2 threads,
         std::vector<std::string>{"frame_00000.png", "frame_00001.png", "frame_00002.png"});
   CHECK(cmd_compare({frames1.string(), frames2.string()}) == 0);  // bitwise identical (tolerance 0)
   check_golden("render_run.png", read_png(frames1 / "frame_00002.png"));
+}
+
+namespace {
+
+// Two blocks of particles side by side, "left" (blue, x < 0) and "right" (red, x > 0), in front of a
+// translucent "glass" square, with speed and pressure fields: left moves at 0..1 m/s (growing with y) under
+// pressure 1 Pa, right at 5 m/s under -1 Pa. Particle centres: x = -0.55 .. -0.25 and 0.25 .. 0.55,
+// y = -0.25 .. 0.25, step 0.1.
+Snapshot two_blocks() {
+  Snapshot s;
+  s.spacing = 0.1;
+  s.bodies = {body("left", {0.2f, 0.45f, 0.9f}), body("right", {0.9f, 0.35f, 0.25f}),
+              body("glass", {0.9f, 0.9f, 0.2f}, RenderMode::Surface)};
+  s.bodies[2].mesh = square(-0.5f, 5.0f);
+  s.fields = {{"speed", "m/s", {}}, {"pressure", "Pa", {}}};
+  for (int b = 0; b < 2; ++b)
+    for (int x = 0; x < 4; ++x)
+      for (int y = 0; y < 6; ++y) {
+        s.position.insert(s.position.end(), {(b ? 0.25f : -0.55f) + 0.1f * x, -0.25f + 0.1f * y, 0.0f});
+        s.body.push_back(static_cast<uint16_t>(b));
+        s.fields[0].values.push_back(b ? 5.0f : static_cast<float>(y) / 5.0f);
+        s.fields[1].values.push_back(b ? -1.0f : 1.0f);
+      }
+  return s;
+}
+
+// Centre pixel of the particle block at (x, y) world coordinates for front_camera() (fov 35, distance 2).
+std::pair<int, int> pixel_of(double x, double y, int w, int h) {
+  const double f = 1.0 / std::tan(17.5 * std::numbers::pi / 180.0) / 2.0;  // per unit at distance 2
+  return {static_cast<int>(w / 2.0 + x * f * h / 2.0), static_cast<int>(h / 2.0 - y * f * h / 2.0)};
+}
+
+}  // namespace
+
+TEST_CASE("render: per-camera overrides (hide, color_by, colormap, range, clip) change only that camera",
+          "[render]") {
+  RenderSettings settings = small_settings(96, 64);  // black background, color_by material
+  // The run-wide clip removes the upper half (y > 0.05) of "left".
+  settings.clip = Clip{Vec3(0, 0.05, 0), Vec3(0, 1, 0), {0}};
+  const Camera plain = front_camera();
+  Camera overridden = front_camera();
+  overridden.name = "overridden";
+  overridden.hide = {1, 2};  // right, glass
+  overridden.color_by = "pressure";
+  overridden.colormap = "coolwarm";
+  overridden.range = std::make_pair(-1.0, 1.0);
+  Camera unclipped = front_camera();
+  unclipped.name = "unclipped";
+  unclipped.clip = false;
+  // Overrides equal to the run-wide values change nothing.
+  Camera same = front_camera();
+  same.name = "same";
+  same.color_by = "material";
+  same.colormap = "viridis";
+  same.clip = true;
+  settings.cameras = {plain, overridden, unclipped, same};
+  Renderer renderer(settings);
+  const Snapshot snap = two_blocks();
+  const Image a = renderer.render(snap, plain);
+  const Image b = renderer.render(snap, overridden);
+  const Image c = renderer.render(snap, unclipped);
+  CHECK(renderer.render(snap, same) == a);
+  CHECK(renderer.render(snap, plain) == a);  // the overridden camera left no state behind
+
+  // Pixels at particle centres (not between two splats).
+  const auto [rx, ry] = pixel_of(0.35, -0.05, 96, 64);   // right block
+  const auto [lx, ly] = pixel_of(-0.45, -0.15, 96, 64);  // lower (kept) half of left
+  const auto [ux, uy] = pixel_of(-0.45, 0.15, 96, 64);   // upper (clipped) half of left
+  const auto [gx, gy] = pixel_of(0.0, -0.2, 96, 64);     // only the glass, between the blocks
+  auto is_background = [](const Image& im, int x, int y) {
+    return im.at(x, y)[0] == 0 && im.at(x, y)[1] == 0 && im.at(x, y)[2] == 0;
+  };
+  INFO("right " << rx << "," << ry << " left " << lx << "," << ly << " upper " << ux << "," << uy);
+  // Hidden bodies: the right block and the glass are drawn by `plain` but not by `overridden`.
+  CHECK(a.at(rx, ry)[0] > 2 * a.at(rx, ry)[2]);  // red block
+  CHECK(is_background(b, rx, ry));
+  CHECK_FALSE(is_background(a, gx, gy));  // the translucent glass over the black background
+  CHECK(is_background(b, gx, gy));
+  // Colour: body colour (blue) in `plain`; pressure 1 Pa at the top of [-1, 1] in coolwarm (red) in
+  // `overridden`.
+  CHECK(a.at(lx, ly)[2] > a.at(lx, ly)[0] + 60);
+  CHECK(b.at(lx, ly)[0] > b.at(lx, ly)[2] + 60);
+  // Clip: the upper half of "left" is cut away except for the camera with clip false.
+  CHECK_FALSE(is_background(c, ux, uy));
+  CHECK(c.at(ux, uy)[2] > c.at(ux, uy)[0] + 60);  // left's own blue
+  CHECK(a.at(ux, uy)[2] < c.at(ux, uy)[2]);       // cut away there
+  CHECK(is_background(b, ux, uy));                // clipped, glass hidden
+  CHECK(c.at(rx, ry)[0] == a.at(rx, ry)[0]);      // elsewhere the same
+
+  // Ranges: fixed for `overridden`; none for material; chosen at run time otherwise, from the particles the
+  // camera draws (hiding the fast right block leaves 0..1 m/s), shared by cameras that colour alike.
+  CHECK(renderer.field_range(overridden) == std::make_pair(-1.0, 1.0));
+  CHECK_FALSE(renderer.field_range(plain).has_value());
+  CHECK_FALSE(renderer.field_range().has_value());
+  Camera speed_all = front_camera(), speed_left = front_camera();
+  speed_all.color_by = speed_left.color_by = "speed";
+  speed_left.hide = {1};
+  Camera speed_left_too = speed_left;
+  speed_left_too.hide = {1, 1};
+  renderer.render(snap, speed_all);
+  renderer.render(snap, speed_left);
+  CHECK(renderer.field_range(speed_all) == std::make_pair(0.0, 5.0));
+  CHECK(renderer.field_range(speed_left) == std::make_pair(0.0, 1.0));
+  CHECK(renderer.field_range(speed_left_too) == std::make_pair(0.0, 1.0));
+  CHECK_FALSE(renderer.field_range().has_value());  // the run-wide colouring is still "material"
+
+  // A camera whose field the snapshot lacks falls back to body colours, as an empty field always did.
+  Snapshot no_pressure = two_blocks();
+  no_pressure.fields.pop_back();
+  Camera recoloured = front_camera();
+  recoloured.color_by = "pressure";
+  recoloured.colormap = "coolwarm";
+  CHECK(renderer.render(no_pressure, recoloured) == a);
+}
+
+TEST_CASE("render: a camera's own colour bar in its figure; other cameras keep the run-wide one",
+          "[render]") {
+  const ScratchDir scratch("camera_bars");
+  const fs::path& out = scratch.path;
+  RenderSettings settings = small_settings(96, 64);
+  settings.color_by = "speed";
+  Camera valve = front_camera();
+  valve.name = "valve";
+  valve.color_by = "pressure";
+  valve.colormap = "coolwarm";
+  valve.range = std::make_pair(-2.0, 2.0);
+  valve.hide = {1};
+  settings.cameras = {front_camera(), valve};
+  settings.figures = {Figure{"speed_sheet", "front", {0.0, 0.1}, 2},
+                      Figure{"valve_sheet", "valve", {0.0, 0.1}, 2}};
+  std::vector<std::optional<std::pair<double, double>>> ranges;
+  {
+    FramePipeline pipeline(settings, out, 0.1);
+    for (int k = 0; k < 2; ++k) {
+      Snapshot s = two_blocks();
+      s.frame = k;
+      s.time = 0.1 * k;
+      pipeline.push(std::move(s));
+    }
+    pipeline.flush();
+    ranges = pipeline.camera_ranges();
+    pipeline.finish();
+    REQUIRE_FALSE(pipeline.failed());
+    CHECK(pipeline.field_range() == std::make_pair(0.0, 5.0));
+  }
+  REQUIRE(ranges.size() == 2);
+  CHECK(ranges[0] == std::make_pair(0.0, 5.0));
+  CHECK(ranges[1] == std::make_pair(-2.0, 2.0));
+  // Each sheet is exactly its camera's frames with its camera's colour bar: field name, unit, colormap and
+  // range.
+  auto sheet_of = [&](const std::string& camera, const std::optional<ColorBar>& bar) {
+    std::vector<FigurePanel> panels;
+    panels.push_back({read_png(out / "frames" / camera / "frame_00000.png"), "t = 0 s"});
+    panels.push_back({read_png(out / "frames" / camera / "frame_00001.png"), "t = 0.1 s"});
+    return compose_figure(panels, 2, bar);
+  };
+  const ColorBar speed_bar{"viridis", 0.0, 5.0, "speed", "m/s"},
+      valve_bar{"coolwarm", -2.0, 2.0, "pressure", "Pa"};
+  const Image speed_sheet = read_png(out / "figures" / "speed_sheet.png");
+  const Image valve_sheet = read_png(out / "figures" / "valve_sheet.png");
+  CHECK(speed_sheet == sheet_of("front", speed_bar));
+  CHECK(valve_sheet == sheet_of("valve", valve_bar));
+  CHECK_FALSE(valve_sheet == sheet_of("valve", speed_bar));  // the bar is not the run-wide one
+}
+
+TEST_CASE("render: a run with per-camera overrides; the camera without them renders as before", "[render]") {
+  const ScratchDir scratch("camera_overrides");
+  // The scene of the 1-vs-2-threads test above (its "oblique" camera has the golden render_run.png), plus a
+  // front camera and the same view hiding "right" and colouring by speed.
+  const std::string bodies = R"(
+  "name": "tiny_cubes",
+  "domain": { "min": [-1, -1, -1], "max": [1, 1, 1] },
+  "resolution": { "spacing": 0.01, "smoothing_ratio": 1.3 },
+  "time": { "end": 0.01, "output_interval": 0.005, "cfl": 0.25, "max_dt": 1e-3 },
+  "gravity": [0, 0, 0],
+  "materials": { "water": { "type": "fluid", "density": 1000, "viscosity": 1e-6, "sound_speed": 20 } },
+  "bodies": [
+    { "name": "left", "material": "water", "shape": { "box": { "min": [-0.07, -0.03, -0.03], "max": [-0.01, 0.03, 0.03] } },
+      "velocity": [1, 0, 0], "color": [0.2, 0.45, 0.9] },
+    { "name": "right", "material": "water", "shape": { "box": { "min": [0.01, -0.01, -0.03], "max": [0.07, 0.05, 0.03] } },
+      "velocity": [-1, 0, 0], "color": [0.9, 0.35, 0.25] }
+  ],)";
+  const std::string oblique =
+      R"({ "name": "oblique", "eye": [0.07, 0.08, 0.17], "target": [0, 0.01, 0], "up": [0, 1, 0], "fov_deg": 40 })";
+  const std::string with = "{" + bodies + R"(
+  "render": {
+    "width": 96, "height": 64, "background": [1, 1, 1], "color_by": "material",
+    "cameras": [ )" + oblique +
+                           R"(,
+      { "name": "front", "eye": [0, 0.01, 0.3], "target": [0, 0.01, 0], "fov_deg": 40 },
+      { "name": "front_hide", "eye": [0, 0.01, 0.3], "target": [0, 0.01, 0], "fov_deg": 40,
+        "hide": ["right"], "color_by": "speed", "colormap": "coolwarm", "range": [0, 1] } ],
+    "figures": [ { "name": "fig_front", "camera": "front", "times": [0, 0.01] },
+                 { "name": "fig_hide", "camera": "front_hide", "times": [0, 0.01] } ]
+  }
+})";
+  const std::string without = "{" + bodies + R"(
+  "render": { "width": 96, "height": 64, "background": [1, 1, 1], "color_by": "material", "cameras": [ )" +
+                              oblique + R"( ] }
+})";
+  for (const auto& [name, text] : {std::pair{"with", with}, std::pair{"without", without}}) {
+    const fs::path scene = scratch.path / (std::string(name) + ".json");
+    std::ofstream(scene) << text;
+    const std::string cmd = std::string(AORTASPH_BINARY) + " run " + scene.string() + " --quiet --out " +
+                            (scratch.path / name).string() + " > /dev/null 2>&1";
+    REQUIRE(std::system(cmd.c_str()) == 0);
+  }
+  const fs::path out = scratch.path / "with";
+
+  // The camera without overrides: bitwise the frames of the run without the other cameras, and the golden.
+  CHECK(cmd_compare({(out / "frames" / "oblique").string(),
+                     (scratch.path / "without" / "frames" / "oblique").string()}) == 0);
+  check_golden("render_run.png", read_png(out / "frames" / "oblique" / "frame_00002.png"));
+
+  // Hide: where `front` shows the red right cube, `front_hide` shows the white background; color_by: where
+  // `front` shows the blue left cube, `front_hide` shows speed 1 m/s at the top of coolwarm [0, 1] (red).
+  const Image front = read_png(out / "frames" / "front" / "frame_00000.png");
+  const Image hide = read_png(out / "frames" / "front_hide" / "frame_00000.png");
+  int red = 0, blue = 0, red_not_background = 0, blue_not_recoloured = 0;
+  for (int y = 0; y < front.h; ++y)
+    for (int x = 0; x < front.w; ++x) {
+      const uint8_t *f = front.at(x, y), *h = hide.at(x, y);
+      if (f[0] > f[1] + 60 && f[0] > f[2] + 60) {
+        ++red;
+        red_not_background += !(h[0] == 255 && h[1] == 255 && h[2] == 255);
+      }
+      if (f[2] > f[0] + 60) {
+        ++blue;
+        blue_not_recoloured += !(h[0] > h[2] + 20);
+      }
+    }
+  INFO(red << " red pixels, " << blue << " blue pixels");
+  CHECK(red > 200);
+  CHECK(blue > 200);
+  CHECK(red_not_background == 0);
+  CHECK(blue_not_recoloured == 0);
+
+  // Figures: `fig_front` (material) has no colour bar; `fig_hide` has the camera's own: speed [m/s],
+  // coolwarm, 0..1.
+  const Image fig_front = read_png(out / "figures" / "fig_front.png");
+  const Image fig_hide = read_png(out / "figures" / "fig_hide.png");
+  auto sheet_of = [&](const std::string& camera, const std::optional<ColorBar>& bar) {
+    return compose_figure({{read_png(out / "frames" / camera / "frame_00000.png"), "t = 0 s"},
+                           {read_png(out / "frames" / camera / "frame_00002.png"), "t = 0.01 s"}},
+                          3, bar);
+  };
+  CHECK(fig_front == sheet_of("front", std::nullopt));
+  CHECK(fig_hide == sheet_of("front_hide", ColorBar{"coolwarm", 0.0, 1.0, "speed", "m/s"}));
+  CHECK(fig_hide.h > fig_front.h);
+
+  // The resolved scene keeps the cameras as written: absent overrides are not filled in.
+  std::ifstream run_json(out / "run.json");
+  const auto cameras = nlohmann::json::parse(run_json)["scene"]["render"]["cameras"];
+  REQUIRE(cameras.size() == 3);
+  for (const char* key : {"color_by", "colormap", "range", "hide", "clip"})
+    CHECK_FALSE(cameras[0].contains(key));
+  CHECK(cameras[2]["hide"] == nlohmann::json::array({"right"}));
 }
