@@ -165,7 +165,23 @@ void fluid_reaction(const Particles& P, const NeighborSearch& nb, const FluidCon
     Vec3 sum = Vec3::Zero();
     for (uint32_t k = nb.begin(j); k < nb.end(j); ++k) {
       const uint32_t i = idx[k];
-      if (P.kind[i] == Kind::Fluid) sum -= P.m[i] * pair_acceleration(P, ctx, c, FluidI(P, ctx, i), j);
+      if (P.kind[i] != Kind::Fluid) continue;
+      const FluidI I(P, ctx, i);
+      Vec3 a = pair_acceleration(P, ctx, c, I, j);
+      // The background pressure is a device of the fluid's discretisation (it keeps the fluid's pressure
+      // positive against the tensile instability), not a load on the body: a uniform pressure has no net
+      // force on a closed body, but its discrete sum would squeeze a soft solid (a 2 kPa background on a
+      // 5 kPa leaflet). Its share of the pair term, -m_j pb (1/rho_i^2 + 1/rho_j^2) grad W (the boundary
+      // particle's extrapolated pressure carries the same pb), is left out of the reaction.
+      const double pb = I.params->p_background;
+      if (pb != 0.0) {
+        const Vec3 xij = I.x - P.x[j];
+        const double r = xij.norm();
+        if (r > 0.0 && r < ctx.kernel.support)
+          a += P.m[j] * pb * (1.0 / (I.rho * I.rho) + 1.0 / (P.rho[j] * P.rho[j])) *
+               (ctx.kernel.dWdr(r) / r) * xij;
+      }
+      sum -= P.m[i] * a;
     }
     f[j] += sum;
   });
