@@ -1,9 +1,31 @@
 // Small scenes built in code for the physics tests.
 #pragma once
 
+#include <cstdint>
+
 #include "scene.hpp"
+#include "world.hpp"
 
 namespace aortasph::test {
+
+// FNV-1a hash of the whole particle state (position, velocity, density, id, kind), bit for bit: equal
+// hashes, equal states (determinism and checkpoint tests).
+inline uint64_t state_hash(const World& w) {
+  const Particles& P = w.particles();
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&](const void* data, std::size_t bytes) {
+    const auto* c = static_cast<const unsigned char*>(data);
+    for (std::size_t k = 0; k < bytes; ++k) h = (h ^ c[k]) * 1099511628211ull;
+  };
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    mix(P.x[i].data(), sizeof(double) * 3);
+    mix(P.v[i].data(), sizeof(double) * 3);
+    mix(&P.rho[i], sizeof(double));
+    mix(&P.id[i], sizeof(uint32_t));
+    mix(&P.kind[i], sizeof(Kind));
+  }
+  return h;
+}
 
 inline Material water(double c0 = 20.0) {
   Material m;

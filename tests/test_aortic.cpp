@@ -13,6 +13,7 @@
 #include <numbers>
 
 #include "aortic_root.hpp"
+#include "builders.hpp"
 #include "errors.hpp"
 #include "orifice.hpp"
 #include "parallel.hpp"
@@ -22,6 +23,7 @@
 #include "world.hpp"
 
 using namespace aortasph;
+using aortasph::test::state_hash;
 using json = nlohmann::json;
 
 namespace {
@@ -497,21 +499,6 @@ Scene coarse_root_scene(std::vector<std::string> extra = {}) {
   return load_scene(std::string(AORTASPH_TEST_DIR) + "/../scenes/aortic_root.json", sets).scene;
 }
 
-uint64_t hash_state(const World& w) {
-  const Particles& P = w.particles();
-  uint64_t h = 1469598103934665603ull;
-  auto mix = [&](const void* data, std::size_t bytes) {
-    const auto* c = static_cast<const unsigned char*>(data);
-    for (std::size_t k = 0; k < bytes; ++k) h = (h ^ c[k]) * 1099511628211ull;
-  };
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    mix(P.x[i].data(), sizeof(double) * 3);
-    mix(P.v[i].data(), sizeof(double) * 3);
-    mix(&P.id[i], sizeof(uint32_t));
-  }
-  return h;
-}
-
 }  // namespace
 
 TEST_CASE("aortic root in flow: no blood leaves the lumen while the valve is pushed open", "[aortic][flow]") {
@@ -564,7 +551,7 @@ TEST_CASE("aortic root in flow: identical state and probes for 1 and 2 threads",
       const auto v = probes.measure(w);
       values[k].insert(values[k].end(), v.begin(), v.end());
     }
-    hash[k] = hash_state(w);
+    hash[k] = state_hash(w);
   }
   set_threads(before);
   CHECK(hash[0] == hash[1]);

@@ -32,23 +32,6 @@ Totals totals(const World& w) {
   return t;
 }
 
-// Hash of the whole particle state, bit for bit.
-uint64_t state_hash(const World& w) {
-  const Particles& P = w.particles();
-  uint64_t h = 1469598103934665603ull;
-  auto mix = [&](const void* data, std::size_t bytes) {
-    const auto* c = static_cast<const unsigned char*>(data);
-    for (std::size_t k = 0; k < bytes; ++k) h = (h ^ c[k]) * 1099511628211ull;
-  };
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    mix(P.x[i].data(), sizeof(double) * 3);
-    mix(P.v[i].data(), sizeof(double) * 3);
-    mix(&P.rho[i], sizeof(double));
-    mix(&P.id[i], sizeof(uint32_t));
-  }
-  return h;
-}
-
 }  // namespace
 
 TEST_CASE("colliding fluid cubes conserve linear and angular momentum", "[fluid][conservation]") {

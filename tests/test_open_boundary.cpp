@@ -10,6 +10,7 @@
 #include <functional>
 #include <sstream>
 
+#include "builders.hpp"
 #include "checkpoint.hpp"
 #include "errors.hpp"
 #include "parallel.hpp"
@@ -18,6 +19,7 @@
 #include "world.hpp"
 
 using namespace aortasph;
+using aortasph::test::state_hash;
 
 namespace {
 
@@ -119,24 +121,6 @@ Scene tube_scene(const TubeSetup& t) {
   p_in.point = Vec3(0, 3 * dx, 0);
   s.probes = {q, bal, p_out, p_in};
   return s;
-}
-
-// Hash of the whole particle state, bit for bit.
-uint64_t state_hash(const World& w) {
-  const Particles& P = w.particles();
-  uint64_t h = 1469598103934665603ull;
-  auto mix = [&](const void* data, std::size_t bytes) {
-    const auto* c = static_cast<const unsigned char*>(data);
-    for (std::size_t k = 0; k < bytes; ++k) h = (h ^ c[k]) * 1099511628211ull;
-  };
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    mix(P.x[i].data(), sizeof(double) * 3);
-    mix(P.v[i].data(), sizeof(double) * 3);
-    mix(&P.rho[i], sizeof(double));
-    mix(&P.id[i], sizeof(uint32_t));
-    mix(&P.kind[i], sizeof(Kind));
-  }
-  return h;
 }
 
 struct Row {
