@@ -18,6 +18,7 @@
 
 #include "builders.hpp"
 #include "checkpoint.hpp"
+#include "cli_helpers.hpp"
 #include "image.hpp"
 #include "sim_errors.hpp"
 #include "world.hpp"
@@ -168,20 +169,6 @@ TEST_CASE("checkpoint: damaged files and other scenes are refused", "[checkpoint
 // ---- End to end: the aortasph binary ----
 
 namespace {
-
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("aortasph_ckpt_" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 
 int run_cli(const std::string& args, std::string* err = nullptr) {
   const fs::path e = fs::temp_directory_path() / ("aortasph_ckpt_err_" + std::to_string(::getpid()));

@@ -9,33 +9,15 @@
 #include <fstream>
 #include <sstream>
 
+#include "cli_helpers.hpp"
 #include "image.hpp"
 
 namespace fs = std::filesystem;
+using aortasph::test::run_cli;
+using aortasph::test::scratch;
+using aortasph::test::slurp;
 
 namespace {
-
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("aortasph_watch_" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::ostringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-int run_cli(const std::string& args, std::string& err) {
-  const fs::path e = fs::temp_directory_path() / ("aortasph_watch_err_" + std::to_string(::getpid()));
-  const std::string cmd = std::string(AORTASPH_BINARY) + " " + args + " > /dev/null 2> " + e.string();
-  const int status = std::system(cmd.c_str());
-  err = slurp(e);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 const char* kScene = R"({
   "name": "unstable",
