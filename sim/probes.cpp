@@ -27,6 +27,13 @@ struct Sum3 {
   Sum3 operator+(const Sum3& o) const { return {a + o.a, b + o.b, m + o.m}; }
 };
 
+// 1 for the listed bodies, by body index.
+std::vector<char> body_mask(const World& world, const std::vector<int>& bodies) {
+  std::vector<char> in_set(world.bodies().size(), 0);
+  for (int b : bodies) in_set[b] = 1;
+  return in_set;
+}
+
 void add_columns(std::vector<std::string>& cols, const std::string& name,
                  std::initializer_list<const char*> fields) {
   for (const char* f : fields) cols.push_back(name + "." + f);
@@ -101,8 +108,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
     switch (pr.type) {
       case ProbeType::Extent: {
         // Max (or min) coordinate over the bodies' particles inside the region: a water gauge or surge front.
-        std::vector<char> in_set(world.bodies().size(), 0);
-        for (int b : pr.bodies) in_set[b] = 1;
+        const std::vector<char> in_set = body_mask(world, pr.bodies);
         const double sign = pr.stat_max ? 1.0 : -1.0;
         const double best = parallel_reduce(
             n, -std::numeric_limits<double>::infinity(),
@@ -260,8 +266,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
       case ProbeType::OrificeArea: {
         // Open area of the valve projected on the disc (sim/orifice.hpp), the valve's particles in array
         // order (the raster does not depend on the order).
-        std::vector<char> in_set(world.bodies().size(), 0);
-        for (int b : pr.bodies) in_set[b] = 1;
+        const std::vector<char> in_set = body_mask(world, pr.bodies);
         std::vector<Vec3> pts;
         for (std::size_t i = 0; i < n; ++i)
           if (in_set[P.body[i]]) pts.push_back(P.x[i]);
@@ -270,8 +275,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
       }
       case ProbeType::Stress: {
         // Largest and mean von Mises stress (eqs. 16-17, sim/solid_tlsph.hpp) over the bodies' particles.
-        std::vector<char> in_set(world.bodies().size(), 0);
-        for (int b : pr.bodies) in_set[b] = 1;
+        const std::vector<char> in_set = body_mask(world, pr.bodies);
         const Solids& S = world.solids();
         struct MS {
           double max = 0, sum = 0, count = 0;
