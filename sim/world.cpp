@@ -572,12 +572,7 @@ void World::load_state(const StateReader& in) {
   left_domain_ = static_cast<std::size_t>(w.value<uint64_t>());
   const auto moving = w.value<uint64_t>();
   if (moving != moving_at_start_) w.mismatch("moving particles at t = 0", moving, moving_at_start_);
-  // In the order of Profile::phases(), which save_state wrote.
-  double* phases[] = {&profile_.neighbors, &profile_.density,       &profile_.boundary,
-                      &profile_.forces,    &profile_.solid,         &profile_.rigid,
-                      &profile_.integrate, &profile_.open_boundary, &profile_.sort};
-  if (profile_.phases().size() != std::size(phases)) throw std::logic_error("load_state: profile phases");
-  for (double* sec : phases) *sec = w.value<double>();
+  for (double* sec : profile_.slots()) *sec = w.value<double>();  // the order save_state wrote
   w.done();
 
   SectionReader p = in.section("particles");

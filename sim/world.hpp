@@ -2,6 +2,7 @@
 // The scene (materials, parameters) is read-only after construction; step() only writes state.
 #pragma once
 
+#include <array>
 #include <limits>
 #include <string>
 #include <vector>
@@ -38,6 +39,10 @@ struct Profile {
             {"integrate", integrate},
             {"open_boundary", open_boundary},
             {"sort", sort}};
+  }
+  // The same phases as writable slots, in the order of phases() (checkpoint load).
+  std::array<double*, 9> slots() {
+    return {&neighbors, &density, &boundary, &forces, &solid, &rigid, &integrate, &open_boundary, &sort};
   }
   Profile operator-(const Profile& o) const {
     return {neighbors - o.neighbors,
