@@ -605,14 +605,14 @@ class Loader {
     if (type == "point") keys.insert(keys.end(), {"body", "reference"});
     if (type == "flow_rate") keys.insert(keys.end(), {"point", "normal", "radius"});
     if (type == "orifice_area") keys.insert(keys.end(), {"body", "bodies", "point", "normal", "radius"});
-    if (type == "stress") keys.insert(keys.end(), {"bodies"});
+    if (type == "stress" || type == "gap") keys.insert(keys.end(), {"bodies"});
     Obj o(j, path, keys, allowed);
     Probe p;
     p.name = o.string("name");
     if (p.name.empty() || p.name.find_first_of(",\"\n") != std::string::npos)
       fail(o.path("name"), "must be a non-empty name without commas or quotes");
     o.choice("type", {"extent", "pressure", "body", "point", "energy", "momentum", "flow_rate",
-                      "orifice_area", "open_boundary", "stress"});
+                      "orifice_area", "open_boundary", "stress", "gap"});
     if (type == "extent") {
       p.type = ProbeType::Extent;
       const auto names = o.strings("bodies");
@@ -656,6 +656,16 @@ class Loader {
         p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
         if (s.materials[s.bodies[p.bodies.back()].material].type != MaterialType::Elastic)
           fail(index(o.path("bodies"), k), "body '" + names[k] + "' is not elastic: it carries no stress");
+      }
+    } else if (type == "gap") {
+      p.type = ProbeType::Gap;
+      const auto names = o.strings("bodies");
+      if (names.size() < 2) fail(o.path("bodies"), "expected at least two bodies");
+      for (std::size_t k = 0; k < names.size(); ++k) {
+        p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
+        for (std::size_t l = 0; l < k; ++l)
+          if (p.bodies[l] == p.bodies.back())
+            fail(index(o.path("bodies"), k), "body '" + names[k] + "' listed twice");
       }
     } else {
       // The valve: one body (SPEC) or several (`bodies`: the three leaflets of an aortic valve).

@@ -1,9 +1,11 @@
 #include "probes.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <map>
 
 #include "orifice.hpp"
 #include "parallel.hpp"
@@ -32,6 +34,49 @@ std::vector<char> body_mask(const World& world, const std::vector<int>& bodies) 
   std::vector<char> in_set(world.bodies().size(), 0);
   for (int b : bodies) in_set[b] = 1;
   return in_set;
+}
+
+struct GapStats {
+  double min = 0.0;        // smallest distance between particles of different bodies, capped at 2 spacings
+  long long overlaps = 0;  // pairs of particles of different bodies closer than half a spacing
+};
+
+// How close the listed bodies come to each other: for leaflets, whether contact keeps them apart (a leaflet
+// passing through another must bring particles of both closer than half a spacing somewhere). A cell grid of
+// two spacings; min and counts do not depend on the visiting order.
+GapStats body_gap(const World& world, const std::vector<int>& bodies) {
+  const Particles& P = world.particles();
+  const double dx = world.scene().spacing, cell = 2.0 * dx, half2 = 0.25 * dx * dx;
+  const std::vector<char> in_set = body_mask(world, bodies);
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (in_set[P.body[i]]) idx.push_back(i);
+  auto key = [&](const Vec3& x) {
+    return std::array<long long, 3>{static_cast<long long>(std::floor(x.x() / cell)),
+                                    static_cast<long long>(std::floor(x.y() / cell)),
+                                    static_cast<long long>(std::floor(x.z() / cell))};
+  };
+  std::map<std::array<long long, 3>, std::vector<std::size_t>> grid;
+  for (std::size_t i : idx) grid[key(P.x[i])].push_back(i);
+  GapStats g;
+  double min2 = cell * cell;
+  for (std::size_t i : idx) {
+    const auto c = key(P.x[i]);
+    for (long long a = -1; a <= 1; ++a)
+      for (long long b = -1; b <= 1; ++b)
+        for (long long d = -1; d <= 1; ++d) {
+          const auto it = grid.find({c[0] + a, c[1] + b, c[2] + d});
+          if (it == grid.end()) continue;
+          for (std::size_t j : it->second) {
+            if (j <= i || P.body[j] == P.body[i]) continue;
+            const double r2 = (P.x[j] - P.x[i]).squaredNorm();
+            min2 = std::min(min2, r2);
+            if (r2 < half2) ++g.overlaps;
+          }
+        }
+  }
+  g.min = std::sqrt(min2);
+  return g;
 }
 
 void add_columns(std::vector<std::string>& cols, const std::string& name,
@@ -91,6 +136,9 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
         break;
       case ProbeType::Stress:
         add_columns(columns_, pr.name, {"max", "mean"});
+        break;
+      case ProbeType::Gap:
+        add_columns(columns_, pr.name, {"min", "overlaps"});
         break;
     }
   }
@@ -291,6 +339,11 @@ std::vector<double> ProbeSet::measure(const World& world) const {
               return MS{std::max(a.max, b.max), a.sum + b.sum, a.count + b.count};
             });
         out.insert(out.end(), {r.max, r.count > 0 ? r.sum / r.count : 0.0});
+        break;
+      }
+      case ProbeType::Gap: {
+        const GapStats g = body_gap(world, pr.bodies);
+        out.insert(out.end(), {g.min, static_cast<double>(g.overlaps)});
         break;
       }
     }

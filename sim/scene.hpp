@@ -126,13 +126,14 @@ enum class ProbeType {
   FlowRate,
   OrificeArea,
   OpenBoundary,
-  Stress
+  Stress,
+  Gap
 };
 
 struct Probe {
   std::string name;
   ProbeType type = ProbeType::Extent;
-  std::vector<int> bodies;  // extent, orifice_area, stress: indices into Scene::bodies
+  std::vector<int> bodies;  // extent, orifice_area, stress, gap: indices into Scene::bodies
   int body = -1;            // body, point, orifice_area
   int axis = 0;             // extent: 0,1,2 = x,y,z
   bool stat_max = true;     // extent: max or min

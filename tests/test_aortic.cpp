@@ -580,6 +580,12 @@ TEST_CASE("aortic root probes: orifice_area of the closed valve, leaflet stress,
   INFO("closed orifice " << value("orifice") << " m^2 of " << geo.annulus_area());
   CHECK(value("orifice") < 0.02 * geo.annulus_area());
   CHECK(value("leaflet_stress.max") == 0.0);
+  // The closed leaflets meet about one spacing apart across the coaptation planes, none closer than half.
+  INFO("closed leaflets: nearest particles of two leaflets " << value("leaflet_gap.min") / s.spacing
+                                                             << " dx");
+  CHECK(value("leaflet_gap.min") > 0.5 * s.spacing);
+  CHECK(value("leaflet_gap.min") < 1.2 * s.spacing);
+  CHECK(value("leaflet_gap.overlaps") == 0.0);
   // Clamped leaflet particles are those along the attachment, in the World as in the generator (an inflow
   // buffer that replaces blood renumbers the particles: the clamps must follow the ids).
   std::size_t held = 0;
@@ -623,4 +629,34 @@ TEST_CASE("aortic root probes: orifice_area of the closed valve, leaflet stress,
   CHECK(error_of("probes.3.bodies=[\"blood\"]").find("probes[3].bodies[0]") != std::string::npos);
   CHECK(error_of("probes.2.bodies=[\"lvot_cap\"]").find("probes[2].radius") != std::string::npos);
   CHECK(error_of("probes.2.body=\"leaflet0\"").find("either 'body' or 'bodies'") != std::string::npos);
+  CHECK(error_of("probes.4.bodies=[\"leaflet0\"]").find("probes[4].bodies: expected at least two") !=
+        std::string::npos);
+  CHECK(error_of("probes.4.bodies=[\"leaflet0\",\"leaflet0\"]").find("listed twice") != std::string::npos);
+}
+
+TEST_CASE("gap probe: the nearest distance between particles of two bodies", "[scene]") {
+  // Two walls of 3 x 3 x 3 particles (dx = 1 cm) side by side along x; the second is moved so that its
+  // first column lies 1.3 dx, then 0.53 dx, from the first wall's last one.
+  for (const double gap : {1.3, 0.53}) {
+    const double dx = 0.01;
+    Scene s;
+    s.name = "gap";
+    s.spacing = dx;
+    s.domain = {Vec3(-1, -1, -1), Vec3(1, 1, 1)};
+    s.materials = {test::wall()};
+    const double x1 = 3 * dx + (gap - 1.0) * dx;
+    s.bodies = {test::box_body("a", 0, Vec3::Zero(), Vec3(3 * dx, 3 * dx, 3 * dx)),
+                test::box_body("b", 0, Vec3(x1, 0, 0), Vec3(x1 + 3 * dx, 3 * dx, 3 * dx))};
+    Probe p;
+    p.name = "g";
+    p.type = ProbeType::Gap;
+    p.bodies = {0, 1};
+    s.probes = {p};
+    World w(s);
+    const auto v = ProbeSet(s, w).measure(w);
+    REQUIRE(v.size() == 2);
+    INFO("gap " << gap << " dx: measured " << v[0] / dx << " dx");
+    CHECK(v[0] == Approx(gap * dx).epsilon(1e-9));
+    CHECK(v[1] == 0.0);
+  }
 }
