@@ -601,11 +601,13 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
   for (const Body& b : scene.bodies)
     if (b.shape.kind == ShapeKind::AorticRoot && b.shape.aortic_part == AorticPart::Leaflet) {
       const double t = b.shape.aortic.leaflet_layers * scene.spacing;
+      const double E = scene.materials[b.material].youngs_modulus;
+      // E_real = E (t / t_real)^3: the inverse of bending_equivalent_modulus, t_real = 0.4 mm.
+      const double E_real = E / bending_equivalent_modulus(1.0, 0.4e-3, t);
       std::printf(
-          "  aortic leaflets %g mm thick (%d layers): a real 0.4 mm leaflet of E = 2 MPa bends like E = %.3g "
-          "kPa "
-          "here (E t^3 kept; docs/scenes.md)\n",
-          t * 1e3, b.shape.aortic.leaflet_layers, bending_equivalent_modulus(2e6, 0.4e-3, t) / 1e3);
+          "  aortic leaflets %g mm thick (%d layers): E = %.3g kPa here bends like a real 0.4 mm leaflet "
+          "of E = %.3g MPa (E t^3 kept; docs/scenes.md)\n",
+          t * 1e3, b.shape.aortic.leaflet_layers, E / 1e3, E_real / 1e6);
       break;
     }
   const double dt = world.stable_dt();
