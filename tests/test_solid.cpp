@@ -380,7 +380,8 @@ TEST_CASE(
 }
 
 // Measurement harness for the cantilever period (issue 5, item 3), not yet a pass/fail test: at 4 layers the
-// period is 1.20-1.31 x Euler-Bernoulli, at 6 layers 1.09-1.14 x (docs in the session note).
+// period is 1.20-1.31 x Euler-Bernoulli, at 6 layers 1.09-1.14 x (docs/validation.md). Environment: LAYERS,
+// HG, AV, RATIO, CFL, PERIODS.
 TEST_CASE("TL-SPH scratch: beam period vs resolution", "[.scratch]") {
   const double L = 0.2, H = 0.02;
   const int layers = std::getenv("LAYERS") ? std::atoi(std::getenv("LAYERS")) : 4;
@@ -390,6 +391,7 @@ TEST_CASE("TL-SPH scratch: beam period vs resolution", "[.scratch]") {
   if (std::getenv("AV")) mat.solid_art_viscosity = std::atof(std::getenv("AV"));
   Scene sc = beam_scene(L, H, H, 0.03, dx, mat);
   if (std::getenv("RATIO")) sc.smoothing_ratio = std::atof(std::getenv("RATIO"));
+  if (std::getenv("CFL")) sc.cfl = std::atof(std::getenv("CFL"));
   World w(sc);
   const double omega = std::pow(1.875104 / L, 2) * std::sqrt(2e6 * H * H / 12.0 / 1000.0);
   const double T = 2 * std::numbers::pi / omega;
