@@ -1,12 +1,11 @@
 #include "probes.hpp"
 
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
-#include <map>
 
+#include "neighbors.hpp"
 #include "orifice.hpp"
 #include "parallel.hpp"
 #include "sim_errors.hpp"
@@ -42,39 +41,32 @@ struct GapStats {
 };
 
 // How close the listed bodies come to each other: for leaflets, whether contact keeps them apart (a leaflet
-// passing through another must bring particles of both closer than half a spacing somewhere). A cell grid of
-// two spacings; min and counts do not depend on the visiting order.
+// passing through another must bring particles of both closer than half a spacing somewhere). Pairs within
+// two spacings from a NeighborSearch over the bodies' particles; min and counts do not depend on the visiting
+// order.
 GapStats body_gap(const World& world, const std::vector<int>& bodies) {
   const Particles& P = world.particles();
-  const double dx = world.scene().spacing, cell = 2.0 * dx, half2 = 0.25 * dx * dx;
+  const double dx = world.scene().spacing, reach = 2.0 * dx, half2 = 0.25 * dx * dx;
   const std::vector<char> in_set = body_mask(world, bodies);
-  std::vector<std::size_t> idx;
+  std::vector<Vec3> x;
+  std::vector<int> body;
   for (std::size_t i = 0; i < P.size(); ++i)
-    if (in_set[P.body[i]]) idx.push_back(i);
-  auto key = [&](const Vec3& x) {
-    return std::array<long long, 3>{static_cast<long long>(std::floor(x.x() / cell)),
-                                    static_cast<long long>(std::floor(x.y() / cell)),
-                                    static_cast<long long>(std::floor(x.z() / cell))};
-  };
-  std::map<std::array<long long, 3>, std::vector<std::size_t>> grid;
-  for (std::size_t i : idx) grid[key(P.x[i])].push_back(i);
+    if (in_set[P.body[i]]) {
+      x.push_back(P.x[i]);
+      body.push_back(P.body[i]);
+    }
+  NeighborSearch nb;
+  nb.build(x, reach);
   GapStats g;
-  double min2 = cell * cell;
-  for (std::size_t i : idx) {
-    const auto c = key(P.x[i]);
-    for (long long a = -1; a <= 1; ++a)
-      for (long long b = -1; b <= 1; ++b)
-        for (long long d = -1; d <= 1; ++d) {
-          const auto it = grid.find({c[0] + a, c[1] + b, c[2] + d});
-          if (it == grid.end()) continue;
-          for (std::size_t j : it->second) {
-            if (j <= i || P.body[j] == P.body[i]) continue;
-            const double r2 = (P.x[j] - P.x[i]).squaredNorm();
-            min2 = std::min(min2, r2);
-            if (r2 < half2) ++g.overlaps;
-          }
-        }
-  }
+  double min2 = reach * reach;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
+      const uint32_t j = nb.index()[k];
+      if (j <= i || body[j] == body[i]) continue;
+      const double r2 = (x[j] - x[i]).squaredNorm();
+      min2 = std::min(min2, r2);
+      if (r2 < half2) ++g.overlaps;
+    }
   g.min = std::sqrt(min2);
   return g;
 }
