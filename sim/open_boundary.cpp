@@ -343,13 +343,10 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
   // replacement would stack on a particle already there, one more at every swing: in a valve cycle's
   // diastole that piled 14,000 extra particles into the aortic outlet in 30 ms.
   std::vector<std::vector<Vec3>> resident(zones_.size());
-  for (std::size_t i = 0; i < n; ++i)
-    if (action[i] == kOutflowToFluid) {
-      for (std::size_t m = 0; m < n; ++m)
-        if (P.kind[m] == Kind::Outflow && action[m] == kNone && zone[m] >= 0)
-          resident[zone[m]].push_back(P.x[m]);
-      break;
-    }
+  if (std::find(action.begin(), action.end(), kOutflowToFluid) != action.end())
+    for (std::size_t m = 0; m < n; ++m)
+      if (P.kind[m] == Kind::Outflow && action[m] == kNone && zone[m] >= 0)
+        resident[zone[m]].push_back(P.x[m]);
   auto has_room = [&](int k, const Vec3& x) {
     for (const Vec3& q : resident[k])
       if ((q - x).squaredNorm() < 0.25 * dx_ * dx_) return false;
