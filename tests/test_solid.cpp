@@ -345,14 +345,9 @@ TEST_CASE(
         worst_hi = std::max(worst_hi, r);
       }
       auto mean_pos = [&](double x) {
-        Vec3 sum = Vec3::Zero();
-        int n = 0;
-        for (std::size_t i = 0; i < P.size(); ++i)
-          if (std::abs(P.x0[i].x() - x) < 0.5 * dx) {
-            sum += P.x[i];
-            ++n;
-          }
-        return Vec3(sum / n);
+        return Vec3(mean_in_slab(w, x, dx, [&](std::size_t i) { return P.x[i].x(); }),
+                    mean_in_slab(w, x, dx, [&](std::size_t i) { return P.x[i].y(); }),
+                    mean_in_slab(w, x, dx, [&](std::size_t i) { return P.x[i].z(); }));
       };
       const Vec3 tip = mean_pos(x_tip), back = mean_pos(x_back);
       const double rot = std::atan2(back.y() - tip.y(), tip.x() - back.x());
