@@ -360,8 +360,8 @@ class Loader {
                 "density_summation",
                 "background_pressure"};
       else if (type == "elastic")
-        keys = {"type", "density", "youngs_modulus", "poisson_ratio", "hourglass", "artificial_viscosity",
-                "model"};
+        keys = {"type",  "density", "youngs_modulus", "poisson_ratio", "hourglass", "artificial_viscosity",
+                "model", "gradient"};
       else if (type == "rigid")
         keys = {"type", "density"};
       Obj o(it.value(), path, keys, allowed);
@@ -387,6 +387,8 @@ class Loader {
         m.solid_art_viscosity = o.non_negative("artificial_viscosity", 1.0);
         if (!o.has("model")) it.value()["model"] = "saint_venant_kirchhoff";
         m.neo_hookean = o.choice("model", {"saint_venant_kirchhoff", "neo_hookean"}) == "neo_hookean";
+        if (!o.has("gradient")) it.value()["gradient"] = "second_order";
+        m.second_order_gradient = o.choice("gradient", {"first_order", "second_order"}) == "second_order";
       } else if (type == "rigid") {
         m.type = MaterialType::Rigid;
         m.density = o.positive("density");

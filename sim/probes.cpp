@@ -241,7 +241,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
           kin += b.kinetic_energy();
           pot -= b.mass * g.dot(b.com);
         }
-        // Elastic solids: sum_s V_s psi(E_s), eqs. (15)-(16) (hourglass springs not counted).
+        // Elastic solids: sum_s V_s psi(E_s), eqs. (15)-(16), plus the hourglass springs' energy.
         const double elastic = world.solids().elastic_energy(P);
         out.insert(out.end(), {kin, pot, elastic, kin + pot + elastic});
         break;

@@ -21,9 +21,9 @@ RigidBody make_rigid_body(int body, const std::vector<Vec3>& x, double m, double
   return b;
 }
 
-void advance_rigid_body(RigidBody& b, double dt) {
-  b.P += dt * b.force;   // eq. (19)
-  b.L += dt * b.torque;  // eq. (20)
+void advance_rigid_body(RigidBody& b, double dt, double kick) {
+  b.P += kick * b.force;   // eq. (19)
+  b.L += kick * b.torque;  // eq. (20)
   b.com += dt * b.velocity();
   const Vec3 w = b.omega();  // eqs. (21), (22) with the new L and the old orientation
   const double angle = w.norm() * dt;

@@ -52,7 +52,11 @@ RigidBody make_rigid_body(int body, const std::vector<Vec3>& x, double m, double
 // One step of eqs. (19)-(22) with the force and torque already summed (gravity included): symplectic Euler,
 // P and L first, then the centre of mass and the orientation with the new velocities. The orientation
 // advances by the exact rotation of angle |omega| dt about omega (a unit quaternion, no drift from
-// normalisation).
-void advance_rigid_body(RigidBody& b, double dt);
+// normalisation). `kick` is the length of the P and L update: dt, or the variable-step leapfrog's mean of the
+// previous and this step (World::integrate).
+void advance_rigid_body(RigidBody& b, double dt, double kick);
+inline void advance_rigid_body(RigidBody& b, double dt) {
+  advance_rigid_body(b, dt, dt);
+}
 
 }  // namespace aortasph

@@ -45,6 +45,9 @@ struct Material {
   double hourglass = 10.0;   // Ganzenmueller 2015 hourglass coefficient
   bool neo_hookean = false;  // false: Saint Venant-Kirchhoff (paper eq. 16); true: compressible neo-Hookean
   double solid_art_viscosity = 1.0;  // artificial viscosity alpha for solids
+  // Gradient correction: true, second order (quadratic moving-least-squares fit); false, first order
+  // (Bonet & Lok 1999). See Solids::Solids().
+  bool second_order_gradient = true;
 };
 
 enum class ShapeKind { Box, Sphere, Cylinder, Container, Tube, AorticRoot, Mesh };

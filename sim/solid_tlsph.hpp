@@ -44,6 +44,7 @@ struct SolidParams {
   double hourglass = 0.0;  // Ganzenmueller's alpha
   double alpha = 0.0;      // artificial viscosity
   bool neo_hookean = false;
+  bool second_order = true;  // gradient correction (Material::second_order_gradient)
   explicit SolidParams(const Material& m);
   SolidParams() = default;
 };
@@ -100,7 +101,7 @@ class Solids {
   double von_mises(std::size_t s) const { return vm_[s]; }
   // Solid index of particle i, or -1 when i is not elastic.
   long slot(std::size_t i) const { return slot_[i] == kNone ? -1 : static_cast<long>(slot_[i]); }
-  // Elastic energy sum_s V_s psi(F_s) [J] of the current positions.
+  // Elastic energy sum_s V_s psi(F_s) of the current positions plus the hourglass springs' energy [J].
   double elastic_energy(const Particles& P) const;
   std::size_t reference_pairs() const { return nbr_.size(); }
 
@@ -126,6 +127,10 @@ class Solids {
   std::vector<uint32_t> s_of_id_;  // particle id -> s
   // State of the step.
   std::vector<Mat3> F_, P_;
+  // P_ plus the hourglass springs' energy differentiated by F (Q_s / V_s, see update_stress()): what the
+  // force loop of eq. (18) uses. Per pair, the springs' mean deviation delta along the pair.
+  std::vector<Mat3> P_force_;
+  std::vector<double> delta_;
   std::vector<double> vm_;
   Mat3 deformation_gradient(const Particles& P, std::size_t s) const;
 };

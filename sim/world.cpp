@@ -341,11 +341,17 @@ void World::step(double dt) {
   ++steps_;
 }
 
-// Symplectic Euler, Algorithm 1 lines 15-16: v(t + dt) = v + dt a; x(t + dt) = x + dt v(t + dt).
+// Symplectic Euler, Algorithm 1 lines 15-16: v(t + dt) = v + dt a; x(t + dt) = x + dt v(t + dt), read as
+// the leapfrog it is (v lives half a step behind x). When the step length changes (outputs at exact times
+// shorten a step; the adaptive step drifts) the kick spans the two half steps around x(t), (dt_prev + dt) /
+// 2, the variable-step leapfrog (Hairer, Lubich & Wanner 2006, sec. VIII.1). A kick of dt alone mistimes v by
+// (dt_prev - dt) / 2 at every change, and output times repeating every few steps then pump energy into the
+// modes near half their frequency: a TL-SPH beam sampled every 55 steps gained 500x its energy.
 void World::integrate(double dt) {
+  const double kick = kick_length(dt);
   parallel_for(P_.size(), [&](std::size_t i) {
     if (P_.kind[i] != Kind::Fluid && P_.kind[i] != Kind::Elastic) return;
-    P_.v[i] += dt * P_.a[i];
+    P_.v[i] += kick * P_.a[i];
     P_.x[i] += dt * P_.v[i];
   });
   struct Extremes {
@@ -413,7 +419,7 @@ void World::step_rigid(double dt) {
     b.force += force_[i];
     b.torque += (P_.x[i] - b.com).cross(force_[i]) + moment_[i];
   }
-  for (RigidBody& b : rigid_) advance_rigid_body(b, dt);
+  for (RigidBody& b : rigid_) advance_rigid_body(b, dt, kick_length(dt));
   parallel_for(n, [&](std::size_t i) {
     if (P_.kind[i] != Kind::Rigid) return;
     const RigidBody& b = rigid_[bodies_[P_.body[i]].rigid];
