@@ -342,11 +342,11 @@ void World::step(double dt) {
 }
 
 // Symplectic Euler, Algorithm 1 lines 15-16: v(t + dt) = v + dt a; x(t + dt) = x + dt v(t + dt), read as
-// the leapfrog it is (v lives half a step behind x). When the step length changes (outputs at exact times
-// shorten a step; the adaptive step drifts) the kick spans the two half steps around x(t), (dt_prev + dt) /
-// 2, the variable-step leapfrog (Hairer, Lubich & Wanner 2006, sec. VIII.1). A kick of dt alone mistimes v by
-// (dt_prev - dt) / 2 at every change, and output times repeating every few steps then pump energy into the
-// modes near half their frequency: a TL-SPH beam sampled every 55 steps gained 500x its energy.
+// the leapfrog it is (v lives half a step behind x). When the step length changes (advance_to() splits each
+// output interval evenly, so it changes at output times; the adaptive step drifts) the kick spans the two
+// half steps around x(t), (dt_prev + dt) / 2, the variable-step leapfrog (Hairer, Lubich & Wanner 2006, sec.
+// VIII.1). A kick of dt alone mistimes v by (dt_prev - dt) / 2 at every change; with a shortened step before
+// each output, every 55 steps, a TL-SPH beam gained 500x its energy.
 void World::integrate(double dt) {
   const double kick = kick_length(dt);
   parallel_for(P_.size(), [&](std::size_t i) {
