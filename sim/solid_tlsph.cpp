@@ -163,27 +163,23 @@ Solids::Solids(const Particles& P, const std::vector<Material>& materials, const
         d.z() * d.x();
     return p;
   };
-  {
-    parallel_for(n, [&](std::size_t s) {
-      if (!params_[material_[s]].second_order) return;
-      // Scaled by dx so that the matrix entries are of order one.
-      Eigen::Matrix<double, 9, 9> M = Eigen::Matrix<double, 9, 9>::Zero();
-      for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
-        const uint32_t t = nbr_[k];
-        const Vec3 d = (X_[t] - X_[s]) / dx;
-        const auto p = basis(d);
-        M += (volume_[t] * kernel.W(d.norm() * dx)) * p * p.transpose();
-      }
-      const Eigen::FullPivLU<Eigen::Matrix<double, 9, 9>> lu(M);
-      // Rank and conditioning: a direction with too few distinct rows leaves M singular or nearly so.
-      const Eigen::JacobiSVD<Eigen::Matrix<double, 9, 9>> svd(M);
-      const auto sv = svd.singularValues();
-      if (lu.rank() == 9 && sv(8) > 1e-6 * sv(0)) {
-        Minv[s] = lu.inverse();
-        second[s] = 1;
-      }
-    });
-  }
+  parallel_for(n, [&](std::size_t s) {
+    if (!params_[material_[s]].second_order) return;
+    // Scaled by dx so that the matrix entries are of order one.
+    Eigen::Matrix<double, 9, 9> M = Eigen::Matrix<double, 9, 9>::Zero();
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const uint32_t t = nbr_[k];
+      const Vec3 d = (X_[t] - X_[s]) / dx;
+      const auto p = basis(d);
+      M += (volume_[t] * kernel.W(d.norm() * dx)) * p * p.transpose();
+    }
+    // Conditioning: a direction with too few distinct rows leaves M singular or nearly so.
+    const auto sv = Eigen::JacobiSVD<Eigen::Matrix<double, 9, 9>>(M).singularValues();
+    if (sv(8) > 1e-6 * sv(0)) {
+      Minv[s] = Eigen::FullPivLU<Eigen::Matrix<double, 9, 9>>(M).inverse();
+      second[s] = 1;
+    }
+  });
   // Second-order weights may not be much larger than first-order ones: a one-sided quadratic fit extrapolates
   // (3.3 x at a lattice's surface), and where the fit is barely determined (irregular, curved, thin: some
   // leaflet particles) the weights grow without bound, and with them the highest frequency. Above 4 x the
@@ -260,6 +256,12 @@ double hourglass_stiffness(const SolidParams& sp, double Vs, double Vt, double W
   return 0.5 * sp.hourglass * sp.E * Vs * Vt * W / X2;
 }
 
+// The pair's mean deviation along the pair, delta = ((F_s X - x) . e + (F_t X - x) . e) / 2, with X = X_t -
+// X_s, x = x_t - x_s, e = x / |x|.
+double hourglass_delta(const Mat3& Fs, const Mat3& Ft, const Vec3& X, const Vec3& x, const Vec3& e) {
+  return 0.5 * ((Fs * X - x).dot(e) + (Ft * X - x).dot(e));
+}
+
 }  // namespace
 
 // Hourglass control (Ganzenmueller 2015, eqs. 19-23). For a pair s-t, eps = F_s X_st - x_st is where F_s
@@ -279,7 +281,7 @@ void Solids::update_stress(const Particles& P) {
     P_[s] = st.P;
     vm_[s] = st.von_mises;
   });
-  delta_.resize(nbr_.size());
+  hourglass_pair_.resize(nbr_.size());
   P_force_.resize(X_.size());
   parallel_for(X_.size(), [&](std::size_t s) {
     const SolidParams& sp = params_[material_[s]];
@@ -292,13 +294,17 @@ void Solids::update_stress(const Particles& P) {
       const Vec3 xij = P.x[at_[t]] - xs;  // from s to t, current
       const double r = xij.norm();
       if (r <= 0.0) {
-        delta_[k] = 0.0;
+        hourglass_pair_[k] = Vec3::Zero();
         continue;
       }
       const Vec3 e = xij / r, X = X_[t] - X_[s];
-      delta_[k] = 0.5 * ((F_[s] * X - xij).dot(e) + (F_[t] * X - xij).dot(e));
-      Q += (0.5 * hourglass_stiffness(sp, volume_[s], volume_[t], w_ij_[k], X.squaredNorm()) * delta_[k]) *
-           e * X.transpose();
+      const double delta = hourglass_delta(F_[s], F_[t], X, xij, e);
+      const double k_hg = hourglass_stiffness(sp, volume_[s], volume_[t], w_ij_[k], X.squaredNorm());
+      Q += (0.5 * k_hg * delta) * e * X.transpose();
+      // The pair term on s, k delta d(delta)/dx_s with d(delta)/dx_s = e - (I - e e^T) eps_mean / r
+      // (add_forces() subtracts it).
+      const Vec3 eps = 0.5 * (F_[s] + F_[t]) * X - xij;
+      hourglass_pair_[k] = (k_hg * delta) * (e - (eps - eps.dot(e) * e) / r);
     }
     P_force_[s] += Q / volume_[s];
   });
@@ -324,15 +330,8 @@ void Solids::add_forces(const Particles& P, std::vector<Vec3>& f) const {
       const Vec3 xij = P.x[j] - xi;  // from s to t, current
       const double r = xij.norm();
       if (r <= 0.0) continue;
-      const Vec3 e = xij / r;
-      // Hourglass control, the pair term (see update_stress()): -k delta d(delta)/dx_s, with d(delta)/dx_s =
-      // e - (I - e e^T) eps_mean / r.
-      if (sp.hourglass > 0.0) {
-        const Vec3 X = X_[t] - X_[s];
-        const Vec3 eps = 0.5 * (F_[s] + F_[t]) * X - xij;
-        const double k_hg = hourglass_stiffness(sp, volume_[s], volume_[t], w_ij_[k], X.squaredNorm());
-        other -= (k_hg * delta_[k]) * (e - (eps - eps.dot(e) * e) / r);
-      }
+      // Hourglass control, the pair term found by update_stress().
+      if (sp.hourglass > 0.0) other -= hourglass_pair_[k];
       // Artificial viscosity (Monaghan 1992) for approaching pairs, on the current distance.
       if (sp.alpha > 0.0) {
         const Vec3 x_ij = -xij;  // x_s - x_t
@@ -368,7 +367,7 @@ double Solids::elastic_energy(const Particles& P) const {
             const double r = xij.norm();
             if (r <= 0.0) continue;
             const Vec3 e_ij = xij / r, X = X_[t] - X_[s];
-            const double delta = 0.5 * ((F[s] * X - xij).dot(e_ij) + (F[t] * X - xij).dot(e_ij));
+            const double delta = hourglass_delta(F[s], F[t], X, xij, e_ij);
             const double stiffness =
                 hourglass_stiffness(sp, volume_[s], volume_[t], w_ij_[k], X.squaredNorm());
             e += 0.25 * stiffness * delta * delta;

@@ -128,9 +128,9 @@ class Solids {
   // State of the step.
   std::vector<Mat3> F_, P_;
   // P_ plus the hourglass springs' energy differentiated by F (Q_s / V_s, see update_stress()): what the
-  // force loop of eq. (18) uses. Per pair, the springs' mean deviation delta along the pair.
+  // force loop of eq. (18) uses. Per pair (s's list), the springs' pair term on s, subtracted from its force.
   std::vector<Mat3> P_force_;
-  std::vector<double> delta_;
+  std::vector<Vec3> hourglass_pair_;
   std::vector<double> vm_;
   Mat3 deformation_gradient(const Particles& P, std::size_t s) const;
 };
