@@ -758,8 +758,7 @@ TEST_CASE(
   INFO("step " << w.last_dt() << " s (bound " << bound << "); closest " << min_gap / dx << " dx, "
                << max_overlaps << " pairs under dx/2; energy max / start " << max_e / e0 << "; mean vx left "
                << vl << ", right " << vr << " m/s; total px " << px);
-  CHECK(min_gap > 0.5 * dx);
-  CHECK(max_overlaps == 0);
+  CHECK(min_gap > 0.5 * dx);  // so no pair under dx / 2 either (max_overlaps, reported above)
   CHECK(max_e < 1.001 * e0);
   CHECK(vl < -0.05);  // moving apart
   CHECK(vr > 0.05);
