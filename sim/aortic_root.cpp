@@ -41,7 +41,7 @@ double wrap(double a) {
 constexpr double kFirstRow = 0.5;       // first row's arc length from the attachment line
 constexpr double kSectorMargin = 0.45;  // leaflet particles at least this far from a neighbour's sector
 constexpr double kWallMargin = 0.4;     // ... and this far inside the lumen surface
-constexpr double kClampDepth = 1.75;    // clamped: within this distance of the lumen surface (about 2 rows)
+constexpr double kClampDepth = 1.0;     // clamped: within this distance of the lumen surface (the first row)
 constexpr double kLayerMin = 0.6;       // leaflet particles of one leaflet at least this far apart
 constexpr double kBloodGap = 0.9;       // blood lattice points at least this far from leaflet particles
 constexpr int kMeridianSamples = 100;   // arc-length table along a leaflet meridian
