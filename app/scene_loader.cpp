@@ -272,9 +272,10 @@ class Loader {
   std::set<std::string> shared_root_keys_;
 
   static std::vector<std::string> root_keys() {
-    return {"base",           "annulus_radius", "commissure_radius", "commissure_height", "sinus_radius",
-            "stj_height",     "aorta_radius",   "lvot_length",       "aorta_length",      "leaflet_free_edge",
-            "leaflet_height", "leaflet_layers", "wall_layers",       "commissure_angles", "sinuses"};
+    return {"base",         "annulus_radius",    "commissure_radius", "commissure_height",
+            "sinus_radius", "stj_height",        "aorta_radius",      "lvot_length",
+            "aorta_length", "leaflet_free_edge", "leaflet_height",    "leaflet_layers",
+            "wall_layers",  "commissure_angles", "sinuses",           "leaflet_shape"};
   }
 
   // Reads the aortic_root parameters that o holds over p; with fill, every parameter, defaults written into
@@ -303,6 +304,9 @@ class Loader {
       p.commissure_angles = {v.x(), v.y(), v.z()};
     }
     if (fill || o.has("sinuses")) p.sinuses = o.boolean("sinuses", p.sinuses);
+    if (fill || o.has("leaflet_shape"))
+      p.mirror_leaflets = o.choice("leaflet_shape", {"labrosse", "mirror"},
+                                   p.mirror_leaflets ? "mirror" : "labrosse") == "mirror";
   }
 
   Shape aortic_root_shape(json& j, const std::string& path, double dx) {

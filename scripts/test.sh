@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# All tests: install, then an ASan+UBSan build runs the unit tests (validation-size physics runs and the aortic
-# root in flow left out: they take minutes under the sanitizers), a ThreadSanitizer build runs the
+# All tests: install, then an ASan+UBSan build runs the unit tests (left out: validation-size physics runs, the
+# aortic root in flow, and [long] cases, runs of thousands of steps whose code paths shorter cases cover under the
+# sanitizers; they take minutes there and all run in the Release step), a ThreadSanitizer build runs the
 # simulation-render pipeline test, a bounded libFuzzer run fuzzes the scene loader (scripts/fuzz.sh), then the Release build runs every test through CTest.
 # AORTASPH_SKIP_SANITIZE=1, AORTASPH_SKIP_TSAN=1, AORTASPH_SKIP_FUZZ=1 leave a step out.
 set -euo pipefail
@@ -11,7 +12,7 @@ if [ "${AORTASPH_SKIP_SANITIZE:-0}" != 1 ]; then
   # -O1 -g1: half the compile time of RelWithDebInfo; stack traces keep file and line.
   scripts/build.sh build-asan -DCMAKE_BUILD_TYPE=ASan -DCMAKE_CXX_FLAGS_ASAN="-O1 -g1" -DAORTASPH_SANITIZE=ON
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ./build-asan/tests/aortasph_tests "~[validation]~[flow]~[.]"
+    ./build-asan/tests/aortasph_tests "~[validation]~[flow]~[long]~[.]"
 fi
 if [ "${AORTASPH_SKIP_TSAN:-0}" != 1 ]; then
   # Only the simulation-render pipeline test, built alone (sim + render + one test file): a few minutes.

@@ -64,6 +64,22 @@ AorticRoot::AorticRoot(const AorticRootParams& p) : p_(p) {
   y_c_ = p_.commissure_height -
          std::sqrt(std::max(0.0, half_edge * half_edge - p_.commissure_radius * p_.commissure_radius));
   bulge_ = p_.sinuses ? p_.sinus_radius - cone_radius(0.5 * p_.stj()) : 0.0;
+  if (p_.mirror_leaflets) {
+    // Leaflet k's attachment plane: through its two commissures and its nadir (the annulus mid-sector).
+    auto at = [](double r, double th, double y) { return Vec3(r * std::cos(th), y, -r * std::sin(th)); };
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 ca = at(p_.commissure_radius, phi_[k], p_.commissure_height);
+      const Vec3 cb = at(p_.commissure_radius, phi_[k] + dphi_[k], p_.commissure_height);
+      const Vec3 nadir = at(p_.annulus_radius, phi_[k] + 0.5 * dphi_[k], 0.0);
+      Vec3 n = (cb - ca).cross(nadir - ca).normalized();
+      if (n.y() < 0) n = -n;
+      plane_n_[k] = n;
+      plane_p_[k] = nadir;
+    }
+    y_c_ = mirror_height(0, 0.0, 0.0);
+    sag_ = 0.0;
+    return;
+  }
   // Belly sag S: the mid-line's length grows monotonically with S; bisection to leaflet_height.
   double lo = 0.0, hi = 4.0 * p_.annulus_radius;
   if (midline_length(0.0) >= p_.leaflet_height) {
@@ -97,14 +113,57 @@ int AorticRoot::sector_of(double theta, double& s) const {
   return 0;
 }
 
-double AorticRoot::attachment_height(double s) const {
-  const double c = std::cos(kPi * s);
-  return p_.commissure_height * c * c;
+double AorticRoot::attachment_height(int k, double s) const {
+  if (!p_.mirror_leaflets) {
+    const double c = std::cos(kPi * s);
+    return p_.commissure_height * c * c;
+  }
+  // The plain cone's point at this angle on the attachment plane: bisection in y over [0, commissure height].
+  const double th = phi_[k] + s * dphi_[k];
+  auto side = [&](double y) {
+    const double r = cone_radius(y);
+    return plane_side(k, Vec3(r * std::cos(th), y, -r * std::sin(th)));
+  };
+  double lo = 0.0, hi = p_.commissure_height;
+  if (side(lo) >= 0.0) return lo;
+  if (side(hi) <= 0.0) return hi;
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (side(mid) < 0.0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
-double AorticRoot::bump(double s, double y) const {
+double AorticRoot::plane_side(int k, const Vec3& x) const {
+  return (x - plane_p_[k]).dot(plane_n_[k]);
+}
+
+Vec3 AorticRoot::reflect(int k, const Vec3& x) const {
+  return x - 2.0 * plane_side(k, x) * plane_n_[k];
+}
+
+double AorticRoot::mirror_height(int k, double x, double z) const {
+  // On the plane the point is its own mirror image, inside the cone; going down, the mirror image rises along
+  // the aortic side and leaves the cone: bisection for where it crosses the cone's surface.
+  const Vec3& n = plane_n_[k];
+  const double y_plane =
+      plane_p_[k].y() - ((x - plane_p_[k].x()) * n.x() + (z - plane_p_[k].z()) * n.z()) / n.y();
+  auto outside = [&](double y) {
+    const Vec3 q = reflect(k, Vec3(x, y, z));
+    return std::hypot(q.x(), q.z()) - cone_radius(q.y());
+  };
+  double lo = y_plane - 4.0 * p_.commissure_height, hi = y_plane;
+  if (outside(lo) < 0.0) return lo;
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (outside(mid) > 0.0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+double AorticRoot::bump(int k, double s, double y) const {
   if (bulge_ <= 0.0) return 0.0;
-  const double ya = attachment_height(s), top = p_.stj();
+  const double ya = attachment_height(k, s), top = p_.stj();
   if (y <= ya || y >= top) return 0.0;
   const double w = std::sin(kPi * s);
   return bulge_ * w * w * std::sin(kPi * (y - ya) / (top - ya));
@@ -112,8 +171,8 @@ double AorticRoot::bump(double s, double y) const {
 
 double AorticRoot::lumen_radius(double y, double theta) const {
   double s = 0.0;
-  sector_of(theta, s);
-  return cone_radius(y) + bump(s, y);
+  const int k = sector_of(theta, s);
+  return cone_radius(y) + bump(k, s, y);
 }
 
 double AorticRoot::normal_scale(double y, double theta) const {
@@ -131,10 +190,11 @@ Vec3 AorticRoot::leaflet_surface(int k, double rho, double s, double inset) cons
   const double r_apex = inset / std::sin(half), t_mid = phi_[k] + 0.5 * dphi_[k];
   const double delta = std::asin(std::min(1.0, inset / p_.commissure_radius));
   const double theta = phi_[k] + delta + s * (dphi_[k] - 2 * delta);
-  const double ya = attachment_height(s);
+  const double ya = attachment_height(k, s);
   const double ra = cone_radius(ya);
   const double x = (1 - rho) * r_apex * std::cos(t_mid) + rho * ra * std::cos(theta);
   const double z = -(1 - rho) * r_apex * std::sin(t_mid) - rho * ra * std::sin(theta);
+  if (p_.mirror_leaflets) return Vec3(x, mirror_height(k, x, z), z);
   // Free-edge line plus the attachment's drop below the commissures, fading towards the centre as rho^1.5,
   // less the belly's sag. The sag's profile across the leaflet, 1 - cos^4(pi s), is level at the free edges
   // and flat mid-leaflet, so the belly is a rounded trough rather than a fold along the bisector.
@@ -486,30 +546,32 @@ std::optional<AorticRootError> check_aortic_root(const AorticRootParams& p, doub
     if (p.annulus_radius >= p.sinus_radius)
       return err("sinus_radius", "must be larger than annulus_radius (" + num(p.annulus_radius) + ")");
   }
-  if (p.leaflet_free_edge < 2.0 * p.commissure_radius)
-    return err("leaflet_free_edge",
-               num(p.leaflet_free_edge) +
-                   " is too short to close the valve: at least 2 x commissure_radius = " +
-                   num(2.0 * p.commissure_radius));
-  const double longest = 2.0 * std::hypot(p.commissure_radius, p.commissure_height);
-  if (p.leaflet_free_edge > longest)
-    return err("leaflet_free_edge",
-               num(p.leaflet_free_edge) +
-                   " is too long: the free edges would meet below the annulus plane (at most " +
-                   num(longest) + ")");
+  // Labrosse leaflets follow free_edge and leaflet_height; mirror leaflets follow the root alone.
+  if (!p.mirror_leaflets) {
+    if (p.leaflet_free_edge < 2.0 * p.commissure_radius)
+      return err("leaflet_free_edge",
+                 num(p.leaflet_free_edge) +
+                     " is too short to close the valve: at least 2 x commissure_radius = " +
+                     num(2.0 * p.commissure_radius));
+    const double longest = 2.0 * std::hypot(p.commissure_radius, p.commissure_height);
+    if (p.leaflet_free_edge > longest)
+      return err("leaflet_free_edge",
+                 num(p.leaflet_free_edge) +
+                     " is too long: the free edges would meet below the annulus plane (at most " +
+                     num(longest) + ")");
 
-  const AorticRoot root(p);
-  const double chord = std::hypot(p.annulus_radius, root.coaptation_height());
-  if (p.leaflet_height < chord)
-    return err("leaflet_height",
-               num(p.leaflet_height) +
-                   " is too short to reach from the annulus to the coaptation point (at least " + num(chord) +
-                   ")");
-  const double low = root.leaflet_lowest();
-  if (low < -0.5 * p.annulus_radius)
-    return err("leaflet_height", num(p.leaflet_height) +
-                                     " is too long: the closed leaflet's belly would sag to " + num(low) +
-                                     " below the annulus plane (at most annulus_radius / 2)");
+    const AorticRoot root(p);
+    const double chord = std::hypot(p.annulus_radius, root.coaptation_height());
+    if (p.leaflet_height < chord)
+      return err("leaflet_height",
+                 num(p.leaflet_height) +
+                     " is too short to reach from the annulus to the coaptation point (at least " +
+                     num(chord) + ")");
+    if (root.leaflet_lowest() < -0.5 * p.annulus_radius)
+      return err("leaflet_height",
+                 num(p.leaflet_height) + " is too long: the closed leaflet's belly would sag to " +
+                     num(root.leaflet_lowest()) + " below the annulus plane (at most annulus_radius / 2)");
+  }
 
   if (dx > p.commissure_radius / 6.0)
     return err("spacing", "spacing " + num(dx) +
@@ -518,6 +580,7 @@ std::optional<AorticRootError> check_aortic_root(const AorticRootParams& p, doub
   if (p.leaflet_layers * dx > p.commissure_radius / 4.0)
     return err("leaflet_layers", std::to_string(p.leaflet_layers) + " layers at spacing " + num(dx) +
                                      " make the leaflets too thick (at most commissure_radius / 4)");
+  const double low = AorticRoot(p).leaflet_lowest();
   if (low - 0.5 * p.leaflet_layers * dx < -p.lvot_length + dx)
     return err("lvot_length", num(p.lvot_length) + " is too short: the leaflets reach down to " +
                                   num(low - 0.5 * p.leaflet_layers * dx) + " below the annulus plane");

@@ -41,8 +41,19 @@
 //    sheet is folded tighter than its thickness, offset points closer than 0.6 dx to one already placed are
 //    left out. Points nearer than 0.45 dx to a neighbour's sector or 0.4 dx to the lumen surface are left out
 //    too, so leaflets never overlap each other or the wall (>= 0.9 dx between bodies).
-//  * Clamp: leaflet particles within 1.75 dx of the lumen surface (normal distance, see normal_scale; about
-//    two rows) are flagged clamped.
+//  * Mirror leaflets (leaflet_shape "mirror"): leaflet k's attachment is the cut of the plane P_k through its
+//    two commissures (commissure_radius, commissure_height) and its nadir (annulus_radius, y = 0, mid-sector)
+//    with the plain cone Rc(y); the sinus bulge starts there instead of at the cos^2 crown. The open leaflet
+//    is the cone's surface above P_k, the closed one its reflection across P_k: the same (rho, s) projection
+//    as above, with y such that the point reflected across P_k lies on the cone (bisection). Bending without
+//    stretch keeps a clamped curve's geodesic curvature, so along a fixed curve a sheet can only take its
+//    tangent plane or that plane's mirror image across the curve's osculating plane (do Carmo 1976, sect.
+//    4-4): the open and the closed leaflet are such a pair, so this leaflet opens by bending alone. Free edge
+//    and mid-line lengths follow from the root (27.4 and 19.3 mm with the defaults); leaflet_free_edge and
+//    leaflet_height are not used.
+//  * Clamp: leaflet particles within dx of the lumen surface (normal distance, see normal_scale; the first
+//    row) are flagged clamped. Two rows also held the leaflet's slope, and the opening sheet folded beside
+//    them.
 //  * Wall: rings of particles at y levels (spaced dx, closer where the sinus wall is steep, so spacing along
 //    the wall stays <= dx), each ring wall_layers deep, layer j at R + (j + 1/2) dx (scaled by the wall's
 //    slope so the layers are dx apart along the normal); rings and layers staggered by half a spacing; ends
@@ -100,7 +111,8 @@ class AorticRoot {
   double sector_width(int k) const { return dphi_[k]; }
   // Sector index and fraction s in [0, 1) of a polar angle.
   int sector_of(double theta, double& s) const;
-  double attachment_height(double s) const;
+  double attachment_height(double s) const { return attachment_height(0, s); }
+  double attachment_height(int k, double s) const;
   double coaptation_height() const { return y_c_; }  // centre of the closed valve, above the annulus
   double belly_sag() const { return sag_; }
   // Closed leaflet surface point (root frame, relative to base) at (rho, s) of leaflet k; with inset > 0, the
@@ -122,11 +134,17 @@ class AorticRoot {
 
  private:
   double midline_length(double sag) const;
-  double bump(double s, double y) const;
+  double bump(int k, double s, double y) const;
+  // Mirror leaflets: signed distance of x (root frame) from leaflet k's attachment plane (positive on the
+  // aortic side), the reflection across it, and the closed surface's height above (x, z).
+  double plane_side(int k, const Vec3& x) const;
+  Vec3 reflect(int k, const Vec3& x) const;
+  double mirror_height(int k, double x, double z) const;
 
   AorticRootParams p_;
   double phi_[3], dphi_[3];
   double y_c_ = 0.0, sag_ = 0.0, bulge_ = 0.0;
+  Vec3 plane_n_[3], plane_p_[3];  // mirror leaflets: attachment planes (unit normal, a point)
 };
 
 // Thin-leaflet scaling. A real leaflet is about t = 0.4 mm thick; the particle leaflet is layers x dx thick

@@ -72,6 +72,10 @@ struct AorticRootParams {
   int wall_layers = 3;                // fixed particle layers outside the lumen surface
   std::array<double, 3> commissure_angles = {0.0, 120.0, 240.0};  // about +y (right hand), 0 = +x
   bool sinuses = true;                                            // false: no sinus bulges (a graft)
+  // Closed leaflet shape: false, Labrosse's (free edges straight to the centre, a sagging belly, a cos^2
+  // attachment crown); true, the mirror image of the open leaflet (the plain cone's surface above a planar
+  // attachment) across the attachment's plane (Thubrikar 1990), which opens by bending alone.
+  bool mirror_leaflets = false;
 
   double stj() const { return stj_height > 0.0 ? stj_height : commissure_height; }
   double aorta() const { return aorta_radius > 0.0 ? aorta_radius : commissure_radius; }

@@ -220,6 +220,67 @@ TEST_CASE("aortic root: a graft without sinuses and unequal commissures", "[aort
     for (double th : {0.0, 1.0, 2.5, 4.0}) CHECK(root.lumen_radius(y, th) == Approx(p.annulus_radius));
 }
 
+TEST_CASE("aortic root: mirror leaflets are the open leaflet reflected across a planar attachment",
+          "[aortic]") {
+  AorticRootParams p;
+  p.mirror_leaflets = true;
+  p.base = Vec3(0.01, -0.02, 0.005);
+  const double dx = 0.001;
+  const Parts parts = generate(p, dx);
+  const Measured m = measure(p, parts, dx);
+  INFO("annulus " << m.annulus_radius << ", commissure r " << m.commissure_radius << " h "
+                  << m.commissure_height << ", free edge " << m.free_edge << ", leaflet height "
+                  << m.leaflet_height << ", sinus " << m.sinus_radius << ", orifice " << m.orifice_fraction);
+  CHECK(m.annulus_radius == Approx(p.annulus_radius).epsilon(0.05));
+  CHECK(m.commissure_radius == Approx(p.commissure_radius).epsilon(0.05));
+  CHECK(m.sinus_radius == Approx(p.sinus_radius).epsilon(0.05));
+  CHECK(m.orifice_fraction < 0.02);
+  const AorticRoot root(p);
+  // The free edge is the reflection's cut by the coaptation planes: it dips between the axis and the
+  // commissure, so the quartic fit of measure() does not find the commissure height at its end; the highest
+  // held particle of each leaflet does.
+  for (int k = 0; k < 3; ++k) {
+    double top = -1e9;
+    for (std::size_t i = 0; i < parts.leaflet[k].size(); ++i)
+      if (parts.clamped[k][i]) top = std::max(top, parts.leaflet[k][i].y() - p.base.y());
+    CHECK(top == Approx(p.commissure_height).margin(1.5 * dx));
+  }
+  for (int k = 0; k < 3; ++k) {
+    // The plane through the leaflet's two commissures and its nadir, built here from the parameters.
+    const double a0 = root.sector_start(k), w = root.sector_width(k);
+    auto at = [&](double r, double th, double y) { return Vec3(r * std::cos(th), y, -r * std::sin(th)); };
+    const Vec3 ca = at(p.commissure_radius, a0, p.commissure_height);
+    const Vec3 cb = at(p.commissure_radius, a0 + w, p.commissure_height);
+    const Vec3 nadir = at(p.annulus_radius, a0 + 0.5 * w, 0.0);
+    Vec3 n = (cb - ca).cross(nadir - ca).normalized();
+    if (n.y() < 0) n = -n;
+    double worst = 0.0, below = -1e9, clamp_off = 0.0;
+    for (std::size_t i = 0; i < parts.leaflet[k].size(); ++i) {
+      const Vec3 q = parts.leaflet[k][i] - p.base;
+      const double side = (q - nadir).dot(n);
+      below = std::max(below, side);
+      // Reflected, the closed sheet lies on the plain cone: each particle within half the sheet's thickness
+      // (its layer's offset from the mid-surface) of the cone's surface.
+      const Vec3 r = q - 2.0 * side * n;
+      worst = std::max(worst, std::abs(std::hypot(r.x(), r.z()) - root.cone_radius(r.y())));
+      if (parts.clamped[k][i]) clamp_off = std::max(clamp_off, std::abs(side));
+    }
+    CHECK(worst < 1.1 * dx);
+    CHECK(below < 1.1 * dx);      // the closed sheet on the ventricular side of its attachment plane
+    CHECK(clamp_off < 2.0 * dx);  // held along the plane's cut through the wall (first row, all layers)
+    CHECK(min_distance(parts.leaflet[k], parts.wall, 2 * dx) >= 0.8 * dx);
+    CHECK(min_distance(parts.leaflet[k], parts.blood, 2 * dx) >= 0.85 * dx);
+    CHECK(min_distance(parts.leaflet[k], parts.leaflet[(k + 1) % 3], 2 * dx) >= 0.85 * dx);
+    CHECK(min_distance(parts.leaflet[k], parts.leaflet[(k + 1) % 3], 2 * dx) <= 1.05 * dx);
+  }
+  // The Labrosse sheet is no such reflection: its belly sags below the annulus, far off the cone reflected.
+  AorticRootParams q = p;
+  q.mirror_leaflets = false;
+  const AorticRoot labrosse(q);
+  const Vec3 belly = labrosse.leaflet_surface(0, 0.6, 0.5);
+  CHECK(belly.y() < 0.3 * p.commissure_height);
+}
+
 TEST_CASE("aortic root: parts do not overlap and blood stays in the lumen", "[aortic]") {
   AorticRootParams p;
   p.commissure_angles = {0.0, 110.0, 245.0};

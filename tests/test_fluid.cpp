@@ -34,7 +34,7 @@ Totals totals(const World& w) {
 
 }  // namespace
 
-TEST_CASE("colliding fluid cubes conserve linear and angular momentum", "[fluid][conservation]") {
+TEST_CASE("colliding fluid cubes conserve linear and angular momentum", "[fluid][conservation][long]") {
   Scene s = fluid_cubes(0.01);
   s.materials[0].artificial_viscosity = 0.05;  // every pair term in play
   World w(s);

@@ -161,7 +161,7 @@ double mean(const std::vector<Row>& rows, double t0, double t1, double Row::*fie
 
 }  // namespace
 
-TEST_CASE("tube flow: the mid-tube flow rate matches the prescribed inflow", "[open]") {
+TEST_CASE("tube flow: the mid-tube flow rate matches the prescribed inflow", "[open][long]") {
   TubeSetup t;
   t.initial_velocity = 0.1;  // the paper's set-up: the column already moves, the inflow keeps it going
   const Scene s = tube_scene(t);
@@ -192,7 +192,8 @@ TEST_CASE("tube flow: the mid-tube flow rate matches the prescribed inflow", "[o
   CHECK(std::abs(b.mass_in - b.mass_out - (b.mass_inside - a.mass_inside)) < 1e-12 * a.mass_inside);
 }
 
-TEST_CASE("tube flow from rest: a ramped inflow table is followed, volume balance within 1 %", "[open]") {
+TEST_CASE("tube flow from rest: a ramped inflow table is followed, volume balance within 1 %",
+          "[open][long]") {
   TubeSetup t;
   // The column between a velocity inlet and a pressure outlet is a quarter-wave resonator of period
   // 4 L / c0 = 16 ms at c0 = 2 m/s, L = 8 mm: the ramps take 2.5 periods, so that they excite it little.
@@ -235,7 +236,7 @@ TEST_CASE("tube flow from rest: a ramped inflow table is followed, volume balanc
   CHECK(std::abs(m_in - m_out - (b.mass_inside - a.mass_inside)) < 1e-12 * a.mass_inside);
 }
 
-TEST_CASE("tube flow: the pressure next to the outlet is the prescribed one", "[open]") {
+TEST_CASE("tube flow: the pressure next to the outlet is the prescribed one", "[open][long]") {
   TubeSetup t;
   t.initial_velocity = 0.1;
   t.c0 = 2.0;
@@ -250,7 +251,8 @@ TEST_CASE("tube flow: the pressure next to the outlet is the prescribed one", "[
   CHECK(std::abs(p / p_out - 1.0) < 0.05);
 }
 
-TEST_CASE("tube flow under gravity: a closed inflow holds the column at hydrostatic pressure", "[open]") {
+TEST_CASE("tube flow under gravity: a closed inflow holds the column at hydrostatic pressure",
+          "[open][long]") {
   TubeSetup t;
   t.gravity = Vec3(0, -9.81, 0);
   // c0 >= 10 sqrt(g H) (the usual weakly compressible rule): at c0 = 2 m/s the column's compression (4 %)

@@ -178,7 +178,8 @@ TEST_CASE("head-on contact of two one-particle bodies: restitution and duration"
   }
 }
 
-TEST_CASE("off-axis collision of two boxes: momentum, angular momentum, energy, spin", "[rigid][contact]") {
+TEST_CASE("off-axis collision of two boxes: momentum, angular momentum, energy, spin",
+          "[rigid][contact][long]") {
   const double dx = 0.01;
   Scene s;
   s.name = "boxes";
@@ -243,7 +244,7 @@ TEST_CASE("rigid bodies in fluid: bitwise identical for 1 and 2 threads", "[rigi
   set_threads(2);
 }
 
-TEST_CASE("fluid hits a rigid block without gravity: total momentum is conserved", "[rigid][fluid]") {
+TEST_CASE("fluid hits a rigid block without gravity: total momentum is conserved", "[rigid][fluid][long]") {
   const double dx = 0.01;
   Scene s;
   s.name = "splash";
