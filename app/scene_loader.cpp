@@ -272,10 +272,10 @@ class Loader {
   std::set<std::string> shared_root_keys_;
 
   static std::vector<std::string> root_keys() {
-    return {"base",         "annulus_radius",    "commissure_radius", "commissure_height",
-            "sinus_radius", "stj_height",        "aorta_radius",      "lvot_length",
-            "aorta_length", "leaflet_free_edge", "leaflet_height",    "leaflet_layers",
-            "wall_layers",  "commissure_angles", "sinuses",           "leaflet_shape"};
+    return {"base",           "annulus_radius", "commissure_radius", "commissure_height", "sinus_radius",
+            "stj_height",     "aorta_radius",   "lvot_length",       "aorta_length",      "leaflet_free_edge",
+            "leaflet_height", "leaflet_layers", "wall_layers",       "commissure_angles", "sinuses",
+            "leaflet_shape",  "mirror_tilt"};
   }
 
   // Reads the aortic_root parameters that o holds over p; with fill, every parameter, defaults written into
@@ -307,6 +307,7 @@ class Loader {
     if (fill || o.has("leaflet_shape"))
       p.mirror_leaflets = o.choice("leaflet_shape", {"labrosse", "mirror"},
                                    p.mirror_leaflets ? "mirror" : "labrosse") == "mirror";
+    if (o.has("mirror_tilt")) p.mirror_tilt = o.number("mirror_tilt");
   }
 
   Shape aortic_root_shape(json& j, const std::string& path, double dx) {

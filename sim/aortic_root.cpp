@@ -38,13 +38,14 @@ double wrap(double a) {
 }
 
 // Leaflet sheet: rows this far (in dx) from the attachment line, and the margins that keep bodies apart.
-constexpr double kFirstRow = 0.5;       // first row's arc length from the attachment line
-constexpr double kSectorMargin = 0.45;  // leaflet particles at least this far from a neighbour's sector
-constexpr double kWallMargin = 0.4;     // ... and this far inside the lumen surface
-constexpr double kClampDepth = 1.0;     // clamped: within this distance of the lumen surface (the first row)
-constexpr double kLayerMin = 0.6;       // leaflet particles of one leaflet at least this far apart
-constexpr double kBloodGap = 0.9;       // blood lattice points at least this far from leaflet particles
-constexpr int kMeridianSamples = 100;   // arc-length table along a leaflet meridian
+constexpr double kFirstRow = 0.5;        // first row's arc length from the attachment line
+constexpr double kSectorMargin = 0.45;   // leaflet particles at least this far from a neighbour's sector
+constexpr double kWallMargin = 0.4;      // ... and this far inside the lumen surface
+constexpr double kClampDepth = 1.0;      // clamped: within this distance of the lumen surface (the first row)
+constexpr double kLayerMin = 0.6;        // leaflet particles of one leaflet at least this far apart
+constexpr double kBloodGap = 0.9;        // blood lattice points at least this far from leaflet particles
+constexpr int kMeridianSamples = 100;    // arc-length table along a leaflet meridian
+constexpr int kAttachmentSamples = 512;  // mirror leaflets: attachment heights tabulated across a sector
 
 // Projected distance of a point at polar angle offset a inside a sector of width w, radius r, to the
 // sector's two bounding half-planes (rays in projection).
@@ -75,6 +76,11 @@ AorticRoot::AorticRoot(const AorticRootParams& p) : p_(p) {
       if (n.y() < 0) n = -n;
       plane_n_[k] = n;
       plane_p_[k] = nadir;
+    }
+    for (int k = 0; k < 3; ++k) {
+      attachment_[k].resize(kAttachmentSamples + 1);
+      for (int i = 0; i <= kAttachmentSamples; ++i)
+        attachment_[k][i] = attachment_height(k, static_cast<double>(i) / kAttachmentSamples);
     }
     y_c_ = mirror_height(0, 0.0, 0.0);
     sag_ = 0.0;
@@ -150,7 +156,9 @@ double AorticRoot::mirror_height(int k, double x, double z) const {
       plane_p_[k].y() - ((x - plane_p_[k].x()) * n.x() + (z - plane_p_[k].z()) * n.z()) / n.y();
   auto outside = [&](double y) {
     const Vec3 q = reflect(k, Vec3(x, y, z));
-    return std::hypot(q.x(), q.z()) - cone_radius(q.y());
+    if (p_.mirror_tilt == 0.0) return std::hypot(q.x(), q.z()) - cone_radius(q.y());
+    const double s = wrap(std::atan2(-q.z(), q.x()) - phi_[k]) / dphi_[k];
+    return std::hypot(q.x(), q.z()) - open_radius(k, q.y(), s > 0.5 * (1.0 + kTwoPi / dphi_[k]) ? 0.0 : s);
   };
   double lo = y_plane - 4.0 * p_.commissure_height, hi = y_plane;
   if (outside(lo) < 0.0) return lo;
@@ -159,6 +167,18 @@ double AorticRoot::mirror_height(int k, double x, double z) const {
     (outside(mid) > 0.0 ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
+}
+
+double AorticRoot::open_radius(int k, double y, double s) const {
+  // A ruled surface through the attachment: at each s the line from the attachment point leaning
+  // mirror_tilt outward from the cone's line (the cone below the commissures is straight in y).
+  s = std::clamp(s, 0.0, 1.0);
+  const std::vector<double>& t = attachment_[k];
+  const double f = s * (t.size() - 1);
+  const auto i = std::min(static_cast<std::size_t>(f), t.size() - 2);
+  const double ya = t[i] + (f - i) * (t[i + 1] - t[i]);
+  const double slope = (p_.commissure_radius - p_.annulus_radius) / p_.commissure_height;
+  return cone_radius(ya) + (y - ya) * std::tan(std::atan(slope) + deg(p_.mirror_tilt));
 }
 
 double AorticRoot::bump(int k, double s, double y) const {
@@ -546,6 +566,8 @@ std::optional<AorticRootError> check_aortic_root(const AorticRootParams& p, doub
     if (p.annulus_radius >= p.sinus_radius)
       return err("sinus_radius", "must be larger than annulus_radius (" + num(p.annulus_radius) + ")");
   }
+  if (std::abs(p.mirror_tilt) > 30.0)
+    return err("mirror_tilt", num(p.mirror_tilt) + " is outside [-30, 30] degrees");
   // Labrosse leaflets follow free_edge and leaflet_height; mirror leaflets follow the root alone.
   if (!p.mirror_leaflets) {
     if (p.leaflet_free_edge < 2.0 * p.commissure_radius)

@@ -140,11 +140,14 @@ class AorticRoot {
   double plane_side(int k, const Vec3& x) const;
   Vec3 reflect(int k, const Vec3& x) const;
   double mirror_height(int k, double x, double z) const;
+  // Mirror leaflets: radius of leaflet k's open surface at height y and sector fraction s.
+  double open_radius(int k, double y, double s) const;
 
   AorticRootParams p_;
   double phi_[3], dphi_[3];
   double y_c_ = 0.0, sag_ = 0.0, bulge_ = 0.0;
-  Vec3 plane_n_[3], plane_p_[3];  // mirror leaflets: attachment planes (unit normal, a point)
+  Vec3 plane_n_[3], plane_p_[3];       // mirror leaflets: attachment planes (unit normal, a point)
+  std::vector<double> attachment_[3];  // mirror leaflets: attachment height at s = i / (size - 1)
 };
 
 // Thin-leaflet scaling. A real leaflet is about t = 0.4 mm thick; the particle leaflet is layers x dx thick

@@ -76,6 +76,9 @@ struct AorticRootParams {
   // attachment crown); true, the mirror image of the open leaflet (the plain cone's surface above a planar
   // attachment) across the attachment's plane (Thubrikar 1990), which opens by bending alone.
   bool mirror_leaflets = false;
+  // Mirror leaflets: the open leaflet's lines leave the attachment leaning this much outward (into the sinus)
+  // from the cone's [degrees]; 0: the cone itself.
+  double mirror_tilt = 0.0;
 
   double stj() const { return stj_height > 0.0 ? stj_height : commissure_height; }
   double aorta() const { return aorta_radius > 0.0 ? aorta_radius : commissure_radius; }

@@ -273,6 +273,18 @@ TEST_CASE("aortic root: mirror leaflets are the open leaflet reflected across a 
     CHECK(min_distance(parts.leaflet[k], parts.leaflet[(k + 1) % 3], 2 * dx) >= 0.85 * dx);
     CHECK(min_distance(parts.leaflet[k], parts.leaflet[(k + 1) % 3], 2 * dx) <= 1.05 * dx);
   }
+  // Leaning the open leaflet 6.5 degrees into the sinus lengthens the free edge and shortens the mid-line to
+  // Labrosse's 30 and 17 mm.
+  {
+    AorticRootParams t = p;
+    t.mirror_tilt = 6.5;
+    const Measured mt = measure(t, generate(t, dx), dx);
+    INFO("tilt 6.5: free edge " << mt.free_edge << ", leaflet height " << mt.leaflet_height << ", orifice "
+                                << mt.orifice_fraction);
+    CHECK(mt.free_edge == Approx(p.leaflet_free_edge).epsilon(0.05));
+    CHECK(mt.leaflet_height == Approx(p.leaflet_height).epsilon(0.05));
+    CHECK(mt.orifice_fraction < 0.02);
+  }
   // The Labrosse sheet is no such reflection: its belly sags below the annulus, far off the cone reflected.
   AorticRootParams q = p;
   q.mirror_leaflets = false;
@@ -518,6 +530,7 @@ TEST_CASE("aortic root scenes: impossible geometry is refused naming the paramet
       {{"aortic_root.annulus_radius=-0.01"}, "aortic_root.annulus_radius: must be positive"},
       {{"aortic_root.lvot_length=0.0005"}, "aortic_root.lvot_length"},
       {{"aortic_root.sinuses=1"}, "aortic_root.sinuses: expected true or false"},
+      {{"aortic_root.mirror_tilt=40"}, "aortic_root.mirror_tilt: 40 is outside [-30, 30] degrees"},
       {{"resolution.spacing=0.004"}, "resolution.spacing: spacing 0.004 is too coarse"},
       {{"bodies.0.shape.aortic_root.commissure_radius=0.02"},
        "bodies[0].shape.aortic_root.commissure_radius: must be smaller than sinus_radius"},
