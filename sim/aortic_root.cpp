@@ -77,6 +77,8 @@ AorticRoot::AorticRoot(const AorticRootParams& p) : p_(p) {
       plane_n_[k] = n;
       plane_p_[k] = nadir;
     }
+    const double slope = (p_.commissure_radius - p_.annulus_radius) / p_.commissure_height;
+    lean_ = std::tan(std::atan(slope) + deg(p_.mirror_tilt));
     for (int k = 0; k < 3; ++k) {
       attachment_[k].resize(kAttachmentSamples + 1);
       for (int i = 0; i <= kAttachmentSamples; ++i)
@@ -125,17 +127,24 @@ double AorticRoot::attachment_height(int k, double s) const {
     return p_.commissure_height * c * c;
   }
   // The plain cone's point at this angle on the attachment plane: bisection in y over [0, commissure height].
-  const double th = phi_[k] + s * dphi_[k];
+  const double th = phi_[k] + s * dphi_[k], c = std::cos(th), sn = std::sin(th);
   auto side = [&](double y) {
     const double r = cone_radius(y);
-    return plane_side(k, Vec3(r * std::cos(th), y, -r * std::sin(th)));
+    return plane_side(k, Vec3(r * c, y, -r * sn));
   };
   double lo = 0.0, hi = p_.commissure_height;
-  if (side(lo) >= 0.0) return lo;
-  if (side(hi) <= 0.0) return hi;
+  const double side_lo = side(lo), side_hi = side(hi);
+  if (side_lo >= 0.0) return lo;
+  if (side_hi <= 0.0) return hi;
+  // The cone is straight below the commissures, so side() is linear in y there: its root y0 is known up to
+  // rounding, and side()'s sign is certain at a midpoint farther than `sure` from it. The bisection then takes
+  // the same steps as one that evaluates side() at every midpoint (the same result, bit for bit) and evaluates
+  // it only near the root.
+  const double y0 = -side_lo * (hi - lo) / (side_hi - side_lo), sure = 1e-9 * p_.commissure_height;
   for (int it = 0; it < 60; ++it) {
     const double mid = 0.5 * (lo + hi);
-    (side(mid) < 0.0 ? lo : hi) = mid;
+    const bool below = mid < y0 - sure ? true : mid > y0 + sure ? false : side(mid) < 0.0;
+    (below ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
 }
@@ -177,8 +186,7 @@ double AorticRoot::open_radius(int k, double y, double s) const {
   const double f = s * (t.size() - 1);
   const auto i = std::min(static_cast<std::size_t>(f), t.size() - 2);
   const double ya = t[i] + (f - i) * (t[i + 1] - t[i]);
-  const double slope = (p_.commissure_radius - p_.annulus_radius) / p_.commissure_height;
-  return cone_radius(ya) + (y - ya) * std::tan(std::atan(slope) + deg(p_.mirror_tilt));
+  return cone_radius(ya) + (y - ya) * lean_;
 }
 
 double AorticRoot::bump(int k, double s, double y) const {
@@ -355,6 +363,14 @@ std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8
     }
     return c;
   };
+  // Memoised by s: the rows below sample the same s values (the arc samples), and leaflet_surface is costly
+  // for mirror leaflets (two bisections).
+  std::unordered_map<double, std::vector<double>> meridians;
+  auto meridian_at = [&](double s) -> const std::vector<double>& {
+    auto it = meridians.find(s);
+    if (it == meridians.end()) it = meridians.emplace(s, meridian(s)).first;
+    return it->second;
+  };
   // rho at arc length c from the apex along a meridian.
   auto rho_at = [&](const std::vector<double>& mc, double c) {
     const auto it = std::lower_bound(mc.begin(), mc.end(), c);
@@ -384,7 +400,7 @@ std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8
   // Row i on meridian s: arc length kFirstRow dx + i (L - kFirstRow dx) / (rows - 1) from the attachment;
   // the last row is the apex.
   auto row_rho = [&](int i, double s) {
-    const std::vector<double> mc = meridian(s);
+    const std::vector<double>& mc = meridian_at(s);
     const double L = mc.back();
     const double from_att = kFirstRow * dx + i * (L - kFirstRow * dx) / (rows - 1);
     return rho_at(mc, L - from_att);

@@ -148,6 +148,7 @@ class AorticRoot {
   double y_c_ = 0.0, sag_ = 0.0, bulge_ = 0.0;
   Vec3 plane_n_[3], plane_p_[3];       // mirror leaflets: attachment planes (unit normal, a point)
   std::vector<double> attachment_[3];  // mirror leaflets: attachment height at s = i / (size - 1)
+  double lean_ = 0.0;                  // mirror leaflets: dr/dy of the open surface's lines (open_radius)
 };
 
 // Thin-leaflet scaling. A real leaflet is about t = 0.4 mm thick; the particle leaflet is layers x dx thick
