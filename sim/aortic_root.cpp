@@ -137,9 +137,9 @@ double AorticRoot::attachment_height(int k, double s) const {
   if (side_lo >= 0.0) return lo;
   if (side_hi <= 0.0) return hi;
   // The cone is straight below the commissures, so side() is linear in y there: its root y0 is known up to
-  // rounding, and side()'s sign is certain at a midpoint farther than `sure` from it. The bisection then takes
-  // the same steps as one that evaluates side() at every midpoint (the same result, bit for bit) and evaluates
-  // it only near the root.
+  // rounding, and side()'s sign is certain at a midpoint farther than `sure` from it. The bisection then
+  // takes the same steps as one that evaluates side() at every midpoint (the same result, bit for bit) and
+  // evaluates it only near the root.
   const double y0 = -side_lo * (hi - lo) / (side_hi - side_lo), sure = 1e-9 * p_.commissure_height;
   for (int it = 0; it < 60; ++it) {
     const double mid = 0.5 * (lo + hi);
