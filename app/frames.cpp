@@ -2,6 +2,7 @@
 
 #include "errors.hpp"
 #include "pipeline.hpp"
+#include "renderer.hpp"
 
 namespace aortasph {
 
@@ -69,6 +70,14 @@ std::unique_ptr<FrameSink> make_frame_sink(const Scene& scene, const std::filesy
     return std::make_unique<PipelineSink>(scene, out_dir);
   } catch (const std::exception& e) {
     throw InputError(std::string("render: ") + e.what());
+  }
+}
+
+void validate_render(const Scene& scene) {
+  try {
+    validate_render_settings(scene.render);
+  } catch (const RenderError& e) {
+    throw InputError(e.what());
   }
 }
 

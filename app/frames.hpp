@@ -31,6 +31,10 @@ class FrameSink {
   virtual void adopt_existing_frames(int count) = 0;
 };
 
+// The render settings' checks (renderer's validate_render_settings: sizes, colormaps, ranges, cameras), as an
+// InputError naming the key; `run` calls it before anything is built or written, `check` always.
+void validate_render(const Scene& scene);
+
 // nullptr when the scene has no camera.
 std::unique_ptr<FrameSink> make_frame_sink(const Scene& scene, const std::filesystem::path& out_dir);
 

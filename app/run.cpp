@@ -280,6 +280,7 @@ struct RunRecord {
 int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path& dir, double file_end,
             const StateReader* resume, const RunRecord* record) {
   Scene& scene = loaded.scene;
+  if (!o.no_render) validate_render(scene);  // before the folder, the World and the CSV files
   prepare_out_dir(dir);
   if (o.threads > 0) set_threads(o.threads);
   const int threads = max_threads();
@@ -567,6 +568,7 @@ int cmd_resume(const ResumeOptions& ro) {
 int cmd_check(const std::filesystem::path& file, const std::vector<std::string>& sets) {
   const LoadedScene loaded = load_scene(file, sets);
   const Scene& scene = loaded.scene;
+  validate_render(scene);
   const World world(scene);
   std::printf("scene %s: spacing %g m, h = %g m (ratio %g), domain [%g %g %g] .. [%g %g %g]\n",
               scene.name.c_str(), scene.spacing, world.kernel().h, scene.smoothing_ratio,

@@ -213,6 +213,38 @@ TEST_CASE("bad input: malformed scenes and arguments exit 2 naming the problem",
   CHECK(err.find("no checkpoint") != std::string::npos);
 }
 
+TEST_CASE("bad input: render settings are refused by check, and by run before anything is written",
+          "[bad-input][cli]") {
+  const fs::path dir = scratch("render_settings");
+  std::ofstream(dir / "scene.json") << kGood;
+  const std::string scene = (dir / "scene.json").string();
+  struct Row {
+    const char* set;
+    const char* expect;
+  };
+  const Row rows[] = {
+      {"'render.colormap=\"jet\"'", "render.colormap: unknown colormap \"jet\""},
+      {"'render.cameras.0.colormap=\"hot\"'", "render.cameras[0].colormap: unknown colormap"}};
+  for (const Row& r : rows) {
+    std::string err;
+    const int check = run_cli("check " + scene + " --set " + r.set, err);
+    INFO(r.set << ": check exit " << check << ", stderr: " << err);
+    CHECK(check == 2);
+    CHECK(err.find(r.expect) != std::string::npos);
+    const fs::path out = dir / "out";
+    fs::remove_all(out);
+    const int run = run_cli("run " + scene + " --quiet --out " + out.string() + " --set " + r.set, err);
+    INFO("run exit " << run << ", stderr: " << err);
+    CHECK(run == 2);
+    CHECK(err.find(r.expect) != std::string::npos);
+    CHECK_FALSE(fs::exists(out / "probes.csv"));
+    CHECK_FALSE(fs::exists(out / "diagnostics.csv"));
+    // Without rendering the settings are unused: the run goes ahead.
+    CHECK(run_cli("run " + scene + " --quiet --no-render --out " + out.string() + " --set " + r.set, err) ==
+          0);
+  }
+}
+
 TEST_CASE("bad input: a write error during a run (disk full) exits 2 naming the file", "[bad-input][cli]") {
   const fs::path dir = scratch("full");
   std::ofstream(dir / "scene.json") << kGood;
