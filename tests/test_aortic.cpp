@@ -293,6 +293,31 @@ TEST_CASE("aortic root: mirror leaflets are the open leaflet reflected across a 
   CHECK(belly.y() < 0.3 * p.commissure_height);
 }
 
+TEST_CASE("aortic root: tilted mirror leaflets with unequal commissures close the valve", "[aortic]") {
+  // Each leaflet has its own attachment plane, so with unequal sectors the free edges reach the coaptation
+  // planes at different heights; the valve must still close, and neighbours meet about dx apart.
+  const double dx = 0.001;
+  for (const auto& angles :
+       {std::array<double, 3>{10.0, 115.0, 250.0}, std::array<double, 3>{0.0, 100.0, 230.0}}) {
+    AorticRootParams p;
+    p.mirror_leaflets = true;
+    p.mirror_tilt = 6.5;
+    p.commissure_angles = angles;
+    const Parts parts = generate(p, dx);
+    const Measured m = measure(p, parts, dx);
+    INFO("commissures " << angles[0] << ", " << angles[1] << ", " << angles[2] << ": orifice "
+                        << m.orifice_fraction << " of the annulus");
+    CHECK(m.orifice_fraction < 0.02);
+    for (int k = 0; k < 3; ++k) {
+      const double d = min_distance(parts.leaflet[k], parts.leaflet[(k + 1) % 3], 2 * dx);
+      INFO("leaflets " << k << " and " << (k + 1) % 3 << ": nearest " << d / dx << " dx");
+      CHECK(d >= 0.85 * dx);
+      CHECK(d <= 1.05 * dx);
+      CHECK(min_distance(parts.leaflet[k], parts.wall, 2 * dx) >= 0.8 * dx);
+    }
+  }
+}
+
 TEST_CASE("aortic root: parts do not overlap and blood stays in the lumen", "[aortic]") {
   AorticRootParams p;
   p.commissure_angles = {0.0, 110.0, 245.0};
