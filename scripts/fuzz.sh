@@ -21,5 +21,5 @@ cmake --build "$dir" --target fuzz_scene -j "$(nproc)"
 mkdir -p "$dir/corpus"
 # New inputs go to $dir/corpus; the committed corpus is only read.
 OMP_NUM_THREADS=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ASAN_OPTIONS=detect_leaks=1 \
-  "./$dir/tests/fuzz/fuzz_scene" -max_total_time="$seconds" -max_len=8192 -timeout=60 -rss_limit_mb=2048 \
+  "$dir/tests/fuzz/fuzz_scene" -max_total_time="$seconds" -max_len=8192 -timeout=60 -rss_limit_mb=2048 \
   -print_final_stats=1 -artifact_prefix="$dir/" "$dir/corpus" tests/fuzz/corpus
