@@ -618,15 +618,23 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
   std::printf(
       "  dt estimate %.3g s (cfl %g, max_dt %g), about %.0f steps to t = %g s, %.0f neighbours/particle\n",
       dt, scene.cfl, scene.max_dt, steps, scene.t_end, neighbors);
-  // Cost model: about 1e6 moving-particle-steps per second on 2 cores at ~80 neighbours (aortasph bench);
-  // fixed wall particles cost about a tenth of a moving one. A first guess: the dt adapts during the run.
-  const double moving = static_cast<double>(n - world.count(Kind::Wall));
-  const double walls = static_cast<double>(world.count(Kind::Wall));
-  const double particle_steps = steps * (moving + 0.1 * walls);
+  // Cost model, fitted at stop 14 to the per-phase profiles (diagnostics.csv) of runs on 2 threads without
+  // rendering: per step, 0.0107 us per neighbour pair when there is fluid (the fluid's neighbour, density and
+  // force phases; pairs of two fixed particles are not listed), 0.075 us per particle, and 1.6 us per elastic
+  // particle (TL-SPH). dam_break 18.6 ms per step (measured 18.6), fluid_cubes 14.7 (14.6), flexible_pole 3.7
+  // (4.0); with open boundaries about 1.4 times optimistic (tube_flow 5.3 against 7.2, aortic_root 32.5
+  // against 41). A first guess: the dt adapts during the run, and rendering shares the cores (it nearly
+  // doubled the aortic root's wall time).
+  const bool has_fluid = nf + nin + nout > 0;
+  const double pairs = has_fluid ? static_cast<double>(world.neighbors().pairs()) : 0.0;
+  const double step_2threads = 1.07e-8 * pairs + 7.5e-8 * static_cast<double>(n) +
+                               1.6e-6 * static_cast<double>(world.count(Kind::Elastic));
   const int threads = max_threads();
-  std::printf("  cost estimate: %.3g particle-steps, about %s on %d thread(s); memory about %.0f MB\n",
-              particle_steps, hms(particle_steps / (0.5e6 * threads)).c_str(), threads,
-              static_cast<double>(world.memory_bytes()) / 1e6);
+  const double seconds = steps * step_2threads * 2.0 / threads;
+  std::printf(
+      "  cost estimate: %.3g s per step, about %s on %d thread(s) without rendering; memory about %.0f MB\n",
+      step_2threads * 2.0 / threads, hms(seconds).c_str(), threads,
+      static_cast<double>(world.memory_bytes()) / 1e6);
   std::printf("  outputs: %ld (every %g s), probes: %zu, cameras: %zu\n",
               static_cast<long>(std::floor(scene.t_end / scene.output_interval + 1e-9)) + 1,
               scene.output_interval, scene.probes.size(), scene.render.cameras.size());
