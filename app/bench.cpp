@@ -9,8 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "core/parallel.hpp"
 #include "errors.hpp"
-#include "parallel.hpp"
 #include "render_bench.hpp"
 #include "world.hpp"
 

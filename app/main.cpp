@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "core/sim_errors.hpp"
 #include "errors.hpp"
 #include "render_commands.hpp"
-#include "sim_errors.hpp"
 
 namespace {
 

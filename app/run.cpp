@@ -13,17 +13,17 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "aortic_root.hpp"
-#include "checkpoint.hpp"
 #include "commands.hpp"
+#include "core/parallel.hpp"
+#include "core/sim_errors.hpp"
 #include "errors.hpp"
 #include "frames.hpp"
+#include "geometry/aortic_root.hpp"
+#include "io/checkpoint.hpp"
+#include "io/probes.hpp"
 #include "output.hpp"
-#include "parallel.hpp"
-#include "probes.hpp"
 #include "resources.hpp"
 #include "scene_loader.hpp"
-#include "sim_errors.hpp"
 #include "world.hpp"
 
 namespace aortasph {

@@ -7,8 +7,8 @@
 #include <set>
 #include <sstream>
 
-#include "aortic_root.hpp"
 #include "errors.hpp"
+#include "geometry/aortic_root.hpp"
 
 namespace aortasph {
 

@@ -23,9 +23,9 @@
 #include <vector>
 
 #include "image.hpp"
+#include "io/snapshot.hpp"
 #include "render_error.hpp"
 #include "scene.hpp"
-#include "snapshot.hpp"
 
 namespace aortasph {
 

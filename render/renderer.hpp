@@ -16,9 +16,9 @@
 #include <utility>
 
 #include "image.hpp"
+#include "io/snapshot.hpp"
 #include "render_error.hpp"
 #include "scene.hpp"
-#include "snapshot.hpp"
 
 namespace aortasph {
 

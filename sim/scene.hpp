@@ -52,10 +52,10 @@ struct Material {
 
 enum class ShapeKind { Box, Sphere, Cylinder, Container, Tube, AorticRoot, Mesh };
 
-// Parametric aortic root and valve (sim/aortic_root.hpp; docs/scenes.md). Lengths in metres, angles in
-// degrees. The root's axis is +y through `base` (the centre of the annulus disc); blood flows towards +y.
+// Parametric aortic root and valve (sim/geometry/aortic_root.hpp; docs/scenes.md). Lengths in metres, angles
+// in degrees. The root's axis is +y through `base` (the centre of the annulus disc); blood flows towards +y.
 // Defaults: Labrosse et al. 2006, J. Biomech. 39:2665 (annulus, commissures, leaflet free edge and height);
-// sinus radius 1.4 x annulus radius (see sim/aortic_root.hpp for the source).
+// sinus radius 1.4 x annulus radius (see sim/geometry/aortic_root.hpp for the source).
 struct AorticRootParams {
   Vec3 base = Vec3::Zero();
   double annulus_radius = 0.013;      // basal ring: lumen radius at the annulus plane and of the LVOT below
@@ -172,8 +172,8 @@ struct TimeSeries {
 
 enum class OpenBoundaryType { Inflow, Outflow };
 
-// An inflow or outflow (docs/scenes.md, sim/open_boundary.hpp): a buffer cylinder of `layers` particle layers
-// behind (inflow) or beyond (outflow) the disc of centre `point`, unit `normal` and `radius`.
+// An inflow or outflow (docs/scenes.md, sim/boundary/open_boundary.hpp): a buffer cylinder of `layers`
+// particle layers behind (inflow) or beyond (outflow) the disc of centre `point`, unit `normal` and `radius`.
 struct OpenBoundarySpec {
   std::string name;
   OpenBoundaryType type = OpenBoundaryType::Inflow;

@@ -6,10 +6,10 @@
 #include <limits>
 #include <sstream>
 
-#include "boundary.hpp"
-#include "parallel.hpp"
-#include "shapes.hpp"
-#include "sim_errors.hpp"
+#include "boundary/boundary.hpp"
+#include "core/parallel.hpp"
+#include "core/sim_errors.hpp"
+#include "geometry/shapes.hpp"
 
 namespace aortasph {
 
@@ -326,9 +326,9 @@ void World::step(double dt) {
   integrate(dt);
   profile_.integrate += seconds_since(t0);
 
-  // Open boundaries (sim/open_boundary.hpp): buffers move, particles that crossed an inlet or outlet disc
-  // change role, are created at inflows and removed at outflows (those never count as leaving the domain).
-  // Created or removed particles invalidate the neighbour lists.
+  // Open boundaries (sim/boundary/open_boundary.hpp): buffers move, particles that crossed an inlet or outlet
+  // disc change role, are created at inflows and removed at outflows (those never count as leaving the
+  // domain). Created or removed particles invalidate the neighbour lists.
   t0 = Clock::now();
   if (!open_.empty() && open_.update(P_, nb_, kernel_, gravity_, time_ + dt, dt)) {
     lists_valid_ = false;

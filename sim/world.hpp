@@ -8,17 +8,17 @@
 #include <string>
 #include <vector>
 
-#include "checkpoint.hpp"
-#include "contact_dem.hpp"
-#include "fluid_wcsph.hpp"
-#include "kernel.hpp"
-#include "neighbors.hpp"
-#include "open_boundary.hpp"
-#include "particles.hpp"
-#include "rigid_body.hpp"
+#include "boundary/open_boundary.hpp"
+#include "core/kernel.hpp"
+#include "core/neighbors.hpp"
+#include "core/particles.hpp"
+#include "fluid/fluid_wcsph.hpp"
+#include "io/checkpoint.hpp"
+#include "io/snapshot.hpp"
+#include "rigid/contact_dem.hpp"
+#include "rigid/rigid_body.hpp"
 #include "scene.hpp"
-#include "snapshot.hpp"
-#include "solid_tlsph.hpp"
+#include "solid/solid_tlsph.hpp"
 
 namespace aortasph {
 
@@ -144,7 +144,7 @@ class World {
   // Bytes held by particle arrays and neighbour lists.
   std::size_t memory_bytes() const;
 
-  // Checkpoint (sim/checkpoint.hpp): save_state() writes every piece of state that step() reads (time,
+  // Checkpoint (sim/io/checkpoint.hpp): save_state() writes every piece of state that step() reads (time,
   // counters, all particle arrays, rigid bodies, the Verlet lists' build positions), so that a World built
   // from the same scene and given load_state() continues bitwise as the saved one would have. load_state()
   // throws SetupError when the checkpoint does not fit this scene. New state: add a section to both.

@@ -12,14 +12,14 @@
 #include <map>
 #include <numbers>
 
-#include "aortic_root.hpp"
 #include "builders.hpp"
+#include "core/parallel.hpp"
 #include "errors.hpp"
-#include "orifice.hpp"
-#include "parallel.hpp"
-#include "probes.hpp"
+#include "geometry/aortic_root.hpp"
+#include "geometry/shapes.hpp"
+#include "io/probes.hpp"
+#include "physiology/orifice.hpp"
 #include "scene_loader.hpp"
-#include "shapes.hpp"
 #include "world.hpp"
 
 using namespace aortasph;

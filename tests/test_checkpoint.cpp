@@ -17,10 +17,10 @@
 #include <thread>
 
 #include "builders.hpp"
-#include "checkpoint.hpp"
 #include "cli_helpers.hpp"
+#include "core/sim_errors.hpp"
 #include "image.hpp"
-#include "sim_errors.hpp"
+#include "io/checkpoint.hpp"
 #include "world.hpp"
 
 using namespace aortasph;

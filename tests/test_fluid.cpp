@@ -5,8 +5,8 @@
 #include <sstream>
 
 #include "builders.hpp"
-#include "parallel.hpp"
-#include "probes.hpp"
+#include "core/parallel.hpp"
+#include "io/probes.hpp"
 #include "world.hpp"
 
 using namespace aortasph;

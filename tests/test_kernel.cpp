@@ -2,9 +2,9 @@
 #include <catch2/catch.hpp>
 #include <random>
 
-#include "kernel.hpp"
-#include "neighbors.hpp"
-#include "parallel.hpp"
+#include "core/kernel.hpp"
+#include "core/neighbors.hpp"
+#include "core/parallel.hpp"
 
 using namespace aortasph;
 

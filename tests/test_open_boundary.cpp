@@ -1,5 +1,5 @@
-// Open boundaries (sim/open_boundary.hpp) and the flow probes: a straight tube with an inflow at the bottom
-// and an outflow at the top, no gravity, blood.
+// Open boundaries (sim/boundary/open_boundary.hpp) and the flow probes: a straight tube with an inflow at the
+// bottom and an outflow at the top, no gravity, blood.
 #include <sys/wait.h>
 
 #include <catch2/catch.hpp>
@@ -11,10 +11,10 @@
 #include <sstream>
 
 #include "builders.hpp"
-#include "checkpoint.hpp"
+#include "core/parallel.hpp"
 #include "errors.hpp"
-#include "parallel.hpp"
-#include "probes.hpp"
+#include "io/checkpoint.hpp"
+#include "io/probes.hpp"
 #include "scene_loader.hpp"
 #include "world.hpp"
 

@@ -7,8 +7,8 @@
 #include <fstream>
 
 #include "builders.hpp"
+#include "core/parallel.hpp"
 #include "image.hpp"
-#include "parallel.hpp"
 #include "pipeline.hpp"
 #include "world.hpp"
 

@@ -5,11 +5,11 @@
 #include <sstream>
 
 #include "builders.hpp"
-#include "contact_dem.hpp"
-#include "parallel.hpp"
-#include "probes.hpp"
-#include "rigid_body.hpp"
-#include "sim_errors.hpp"
+#include "core/parallel.hpp"
+#include "core/sim_errors.hpp"
+#include "io/probes.hpp"
+#include "rigid/contact_dem.hpp"
+#include "rigid/rigid_body.hpp"
 #include "world.hpp"
 
 using namespace aortasph;

@@ -2,8 +2,8 @@
 #include <catch2/catch.hpp>
 
 #include "errors.hpp"
+#include "geometry/shapes.hpp"
 #include "scene_loader.hpp"
-#include "shapes.hpp"
 
 using namespace aortasph;
 using json = nlohmann::json;

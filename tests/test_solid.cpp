@@ -8,11 +8,11 @@
 #include <numbers>
 
 #include "builders.hpp"
-#include "parallel.hpp"
-#include "probes.hpp"
+#include "core/parallel.hpp"
+#include "core/sim_errors.hpp"
+#include "io/probes.hpp"
 #include "scene_loader.hpp"
-#include "sim_errors.hpp"
-#include "solid_tlsph.hpp"
+#include "solid/solid_tlsph.hpp"
 #include "world.hpp"
 
 using namespace aortasph;

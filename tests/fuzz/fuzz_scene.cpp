@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "core/sim_errors.hpp"
 #include "errors.hpp"
 #include "resources.hpp"
 #include "scene_loader.hpp"
-#include "sim_errors.hpp"
 #include "world.hpp"
 
 namespace {

@@ -1,4 +1,4 @@
-#include "aortic_root.hpp"
+#include "geometry/aortic_root.hpp"
 
 #include <algorithm>
 #include <cmath>

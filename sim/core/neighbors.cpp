@@ -1,11 +1,11 @@
-#include "neighbors.hpp"
+#include "core/neighbors.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
-#include "parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace aortasph {
 

@@ -13,8 +13,8 @@
 // its own stress), and neither do fluid particles (they interact through pressure).
 #pragma once
 
-#include "neighbors.hpp"
-#include "particles.hpp"
+#include "core/neighbors.hpp"
+#include "core/particles.hpp"
 
 namespace aortasph {
 

@@ -1,14 +1,14 @@
-#include "probes.hpp"
+#include "io/probes.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
 
-#include "neighbors.hpp"
-#include "orifice.hpp"
-#include "parallel.hpp"
-#include "sim_errors.hpp"
+#include "core/neighbors.hpp"
+#include "core/parallel.hpp"
+#include "core/sim_errors.hpp"
+#include "physiology/orifice.hpp"
 
 namespace aortasph {
 
@@ -304,8 +304,8 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         break;
       }
       case ProbeType::OrificeArea: {
-        // Open area of the valve projected on the disc (sim/orifice.hpp), the valve's particles in array
-        // order (the raster does not depend on the order).
+        // Open area of the valve projected on the disc (sim/physiology/orifice.hpp), the valve's particles in
+        // array order (the raster does not depend on the order).
         const std::vector<char> in_set = body_mask(world, pr.bodies);
         std::vector<Vec3> pts;
         for (std::size_t i = 0; i < n; ++i)
@@ -314,7 +314,8 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         break;
       }
       case ProbeType::Stress: {
-        // Largest and mean von Mises stress (eqs. 16-17, sim/solid_tlsph.hpp) over the bodies' particles.
+        // Largest and mean von Mises stress (eqs. 16-17, sim/solid/solid_tlsph.hpp) over the bodies'
+        // particles.
         const std::vector<char> in_set = body_mask(world, pr.bodies);
         const Solids& S = world.solids();
         struct MS {

@@ -76,8 +76,8 @@
 #include <string>
 #include <vector>
 
+#include "geometry/shapes.hpp"
 #include "scene.hpp"
-#include "shapes.hpp"
 
 namespace aortasph {
 

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "io/snapshot.hpp"
 #include "scene.hpp"
-#include "snapshot.hpp"
 
 namespace aortasph {
 
@@ -25,7 +25,7 @@ struct ShapeSample {
 ShapeSample sample_body(const Body& body, double spacing);
 
 // Unit vectors u, v with (u, v, axis) orthonormal: the frame in which tubes (and open boundaries,
-// sim/open_boundary.hpp) lay out their lattice across the axis, so that the two line up.
+// sim/boundary/open_boundary.hpp) lay out their lattice across the axis, so that the two line up.
 void perpendicular_frame(const Vec3& axis, Vec3& u, Vec3& v);
 
 // Centre about which a shape rotates: the centre of its bounding box before rotation.

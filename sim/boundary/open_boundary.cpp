@@ -1,13 +1,13 @@
-#include "open_boundary.hpp"
+#include "boundary/open_boundary.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
-#include "parallel.hpp"
-#include "shapes.hpp"
-#include "sim_errors.hpp"
+#include "core/parallel.hpp"
+#include "core/sim_errors.hpp"
+#include "geometry/shapes.hpp"
 
 namespace aortasph {
 

@@ -1,4 +1,4 @@
-#include "orifice.hpp"
+#include "physiology/orifice.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -26,8 +26,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "kernel.hpp"
-#include "particles.hpp"
+#include "core/kernel.hpp"
+#include "core/particles.hpp"
 
 namespace aortasph {
 

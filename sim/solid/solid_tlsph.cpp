@@ -1,4 +1,4 @@
-#include "solid_tlsph.hpp"
+#include "solid/solid_tlsph.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,9 @@
 #include <limits>
 #include <sstream>
 
-#include "neighbors.hpp"
-#include "parallel.hpp"
-#include "sim_errors.hpp"
+#include "core/neighbors.hpp"
+#include "core/parallel.hpp"
+#include "core/sim_errors.hpp"
 
 namespace aortasph {
 

@@ -1,4 +1,4 @@
-#include "rigid_body.hpp"
+#include "rigid/rigid_body.hpp"
 
 namespace aortasph {
 

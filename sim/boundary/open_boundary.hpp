@@ -36,10 +36,10 @@
 #include <cstdint>
 #include <vector>
 
-#include "fluid_wcsph.hpp"
-#include "kernel.hpp"
-#include "neighbors.hpp"
-#include "particles.hpp"
+#include "core/kernel.hpp"
+#include "core/neighbors.hpp"
+#include "core/particles.hpp"
+#include "fluid/fluid_wcsph.hpp"
 #include "scene.hpp"
 
 namespace aortasph {

@@ -1,11 +1,11 @@
-#include "shapes.hpp"
+#include "geometry/shapes.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
-#include "aortic_root.hpp"
+#include "geometry/aortic_root.hpp"
 
 namespace aortasph {
 

@@ -1,6 +1,6 @@
-#include "fluid_wcsph.hpp"
+#include "fluid/fluid_wcsph.hpp"
 
-#include "parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace aortasph {
 

@@ -1,4 +1,4 @@
-#include "checkpoint.hpp"
+#include "io/checkpoint.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -8,7 +8,7 @@
 #include <fstream>
 #include <string_view>
 
-#include "sim_errors.hpp"
+#include "core/sim_errors.hpp"
 
 namespace aortasph {
 

@@ -12,9 +12,9 @@
 
 #include <cmath>
 
-#include "kernel.hpp"
-#include "neighbors.hpp"
-#include "particles.hpp"
+#include "core/kernel.hpp"
+#include "core/neighbors.hpp"
+#include "core/particles.hpp"
 
 namespace aortasph {
 

@@ -8,7 +8,7 @@
 // zero, for a moving body they are the body's, so moving bodies couple to the fluid through this same code.
 #pragma once
 
-#include "fluid_wcsph.hpp"
+#include "fluid/fluid_wcsph.hpp"
 
 namespace aortasph {
 

@@ -1,8 +1,8 @@
-#include "contact_dem.hpp"
+#include "rigid/contact_dem.hpp"
 
 #include <cmath>
 
-#include "parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace aortasph {
 

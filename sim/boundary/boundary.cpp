@@ -1,6 +1,6 @@
-#include "boundary.hpp"
+#include "boundary/boundary.hpp"
 
-#include "parallel.hpp"
+#include "core/parallel.hpp"
 
 namespace aortasph {
 
@@ -8,7 +8,7 @@ void boundary_from_fluid(Particles& P, const NeighborSearch& nb, const FluidCont
                          const FluidParams& ref) {
   const auto& idx = nb.index();
   parallel_for_dynamic(P.size(), [&](std::size_t w) {
-    if (fluid_like(P.kind[w])) return;  // fluid, and open-boundary buffers (sim/open_boundary.hpp)
+    if (fluid_like(P.kind[w])) return;  // fluid, and open-boundary buffers (sim/boundary/open_boundary.hpp)
     double sum_w = 0.0, sum_pw = 0.0;
     Vec3 sum_rho_x = Vec3::Zero(), sum_v = Vec3::Zero();
     for (uint32_t k = nb.begin(w); k < nb.end(w); ++k) {
