@@ -1,6 +1,9 @@
-// aortasph bench: a standard dam break (about 100k fluid particles, or 12k with --quick) stepped a fixed
-// number of times; prints fluid particle-steps per second, neighbours per particle, bytes per particle and
-// the per-phase profile, and writes bench.json. Speed is measured here, never in unit tests.
+// aortasph bench: a standard case (the dam break: about 100k fluid particles, or 12k with --quick; or the
+// aortic root main job, scenes/aortic_root.json) or any scene file (--scene FILE) stepped a fixed number of
+// times; prints fluid and all moving particle-steps per second, neighbours per particle, bytes per particle
+// (the World's own accounting and the process's peak resident set), the per-phase profile, and writes
+// bench.json. Speed is measured here, never in unit tests.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -12,6 +15,7 @@
 #include "core/parallel.hpp"
 #include "errors.hpp"
 #include "render_bench.hpp"
+#include "scene_loader.hpp"
 #include "world.hpp"
 
 namespace aortasph {
@@ -56,62 +60,112 @@ Scene bench_scene(bool quick) {
   return s;
 }
 
+// Peak resident set size of this process (VmHWM of /proc/self/status) in bytes; 0 where it cannot be read.
+double peak_rss_bytes() {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) {
+      try {
+        return std::stod(line.substr(6)) * 1024.0;  // "VmHWM:   123456 kB"
+      } catch (const std::exception&) {
+        return 0.0;
+      }
+    }
+  }
+  return 0.0;
+}
+
+// Moving particles: every particle but the fixed walls (fluid, open-boundary buffers, elastic, rigid).
+double moving_particles(const World& world) {
+  return static_cast<double>(world.particles().size() - world.count(Kind::Wall));
+}
+
 }  // namespace
 
-int cmd_bench(int threads, bool quick, bool render, const std::filesystem::path& json_out) {
-  if (threads > 0) set_threads(threads);
+int cmd_bench(const BenchOptions& o) {
+  if (o.threads > 0) set_threads(o.threads);
   const int used_threads = max_threads();
-  const Scene scene = bench_scene(quick);
+  Scene scene;
+  if (o.scene) {
+    scene = load_scene(*o.scene, o.sets).scene;
+  } else if (o.case_name == "aortic_root") {
+    scene =
+        load_scene(std::filesystem::path(AORTASPH_SOURCE_DIR) / "scenes" / "aortic_root.json", o.sets).scene;
+  } else if (o.case_name == "dam_break") {
+    if (!o.sets.empty())
+      throw InputError("--set applies to --scene or --case aortic_root, not the dam break");
+    scene = bench_scene(o.quick);
+  } else {
+    throw InputError("--case: unknown case " + o.case_name + " (dam_break, aortic_root)");
+  }
   const int warmup = 5;
-  const int steps = quick ? 40 : 60;
+  const int steps = o.steps > 0 ? o.steps : (o.quick ? 40 : 60);
 
   World world(scene);
-  const double fluid = static_cast<double>(world.count(Kind::Fluid));
-  const double total = static_cast<double>(world.particles().size());
   const double dt = world.stable_dt();
   for (int k = 0; k < warmup; ++k) world.step(dt);
   const Profile before = world.profile();
   const long builds_before = world.list_builds();
+  // Particle counts change with open boundaries: particle-steps are summed step by step.
+  double fluid_steps = 0.0, moving_steps = 0.0;
   const auto t0 = std::chrono::steady_clock::now();
-  for (int k = 0; k < steps; ++k) world.step(world.stable_dt());
+  for (int k = 0; k < steps; ++k) {
+    fluid_steps += static_cast<double>(world.count(Kind::Fluid));
+    moving_steps += moving_particles(world);
+    world.step(world.stable_dt());
+  }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const Profile p = world.profile() - before;
 
-  const double rate = fluid * steps / wall;
+  const double fluid = static_cast<double>(world.count(Kind::Fluid));
+  const double moving = moving_particles(world);
+  const double total = static_cast<double>(world.particles().size());
+  const double rate = fluid_steps / wall;
+  const double moving_rate = moving_steps / wall;
   const double neighbours = static_cast<double>(world.neighbors().pairs()) / total;
-  const double bytes = static_cast<double>(world.memory_bytes()) / fluid;
+  const double bytes = static_cast<double>(world.memory_bytes()) / std::max(fluid, 1.0);
+  const double rss = peak_rss_bytes();
+  const double rss_per_fluid = rss / std::max(fluid, 1.0);
   std::printf("aortasph bench: %s, %d thread(s)\n", scene.name.c_str(), used_threads);
-  std::printf("  particles          %10.0f fluid, %.0f boundary\n", fluid, total - fluid);
+  std::printf("  particles          %10.0f fluid, %.0f moving in all, %.0f boundary\n", fluid, moving,
+              total - moving);
   std::printf("  steps              %10d (after %d warm-up), %.3f s wall\n", steps, warmup, wall);
   std::printf("  fluid particle-steps/s %10.3g\n", rate);
+  std::printf("  particle-steps/s   %10.3g (all moving particles)\n", moving_rate);
   std::printf("  neighbours/particle %9.1f (lists include a skin of 10 %% of the support)\n", neighbours);
   std::printf("  list rebuilds      %10ld in %d steps\n", world.list_builds() - builds_before, steps);
-  std::printf("  bytes/fluid particle %8.0f\n", bytes);
-  std::printf("  phase        seconds   share\n");
+  std::printf("  bytes/fluid particle %8.0f (World accounting), %.0f (peak RSS %.1f MiB)\n", bytes,
+              rss_per_fluid, rss / (1024.0 * 1024.0));
+  std::printf("  phase           seconds   share\n");
   for (const auto& [name, sec] : p.phases())
-    std::printf("  %-10s %9.3f  %5.1f %%\n", name.c_str(), sec, 100.0 * sec / std::max(p.total(), 1e-12));
+    std::printf("  %-13s %9.3f  %5.1f %%\n", name.c_str(), sec, 100.0 * sec / std::max(p.total(), 1e-12));
 
   nlohmann::json j;
   j["scene"] = scene.name;
   j["threads"] = used_threads;
   j["fluid_particles"] = fluid;
+  j["moving_particles"] = moving;
   j["boundary_particles"] = total - fluid;
   j["steps"] = steps;
   j["wall_s"] = wall;
   j["fluid_particle_steps_per_s"] = rate;
+  j["particle_steps_per_s"] = moving_rate;
   j["neighbours_per_particle"] = neighbours;
   j["list_rebuilds"] = world.list_builds() - builds_before;
   j["bytes_per_fluid_particle"] = bytes;
+  j["peak_rss_bytes"] = rss;
+  j["peak_rss_bytes_per_fluid_particle"] = rss_per_fluid;
   for (const auto& [name, sec] : p.phases()) j["phases_s"][name] = sec;
-  if (render) {
+  if (o.render) {
     // Render speed at 1920x1080: drawing and PNG encoding timed separately (render/render_bench).
-    for (const int particles : quick ? std::vector<int>{100000} : std::vector<int>{100000, 1000000}) {
+    for (const int particles : o.quick ? std::vector<int>{100000} : std::vector<int>{100000, 1000000}) {
       const RenderBenchResult r = bench_render(std::cout, particles);
       j["render"][std::to_string(particles)] = {{"draw_ms", r.draw_ms}, {"png_ms", r.png_ms}};
     }
   }
-  std::ofstream f(json_out, std::ios::trunc);
-  if (!f) throw InputError(json_out.string() + ": cannot write");
+  std::ofstream f(o.json, std::ios::trunc);
+  if (!f) throw InputError(o.json.string() + ": cannot write");
   f << std::setw(2) << j << '\n';
   return 0;
 }

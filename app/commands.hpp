@@ -30,7 +30,20 @@ struct ResumeOptions {
 int cmd_run(const RunOptions& options);
 int cmd_resume(const ResumeOptions& options);
 int cmd_check(const std::filesystem::path& scene, const std::vector<std::string>& sets);
-int cmd_bench(int threads, bool quick, bool render, const std::filesystem::path& json_out);
+// aortasph bench [--threads N] [--quick] [--render] [--json FILE] [--case NAME | --scene FILE]
+//                [--set KEY=VALUE]... [--steps N]
+struct BenchOptions {
+  int threads = 0;
+  bool quick = false;
+  bool render = false;
+  std::filesystem::path json = "bench.json";
+  std::string case_name = "dam_break";         // standard cases: dam_break, aortic_root
+  std::optional<std::filesystem::path> scene;  // --scene FILE: any scene instead of a standard case
+  std::vector<std::string> sets;               // --set KEY=VALUE on --scene or --case aortic_root
+  int steps = 0;                               // 0: 60 (40 with --quick)
+};
+
+int cmd_bench(const BenchOptions& options);
 
 // Parses the arguments after the subcommand word (throws InputError on bad arguments).
 RunOptions parse_run_options(const std::vector<std::string>& args);

@@ -23,7 +23,8 @@ const char* kUsage =
     "  aortasph check SCENE.json [--set KEY=VALUE]...   validate and print bodies, counts, h, dt, cost\n"
     "  aortasph compare A B [--diff DIFF.png] [--tolerance T]\n"
     "  aortasph movie DIR [--fps N]\n"
-    "  aortasph bench [--threads N] [--quick] [--render] [--json FILE]\n"
+    "  aortasph bench [--threads N] [--quick] [--render] [--json FILE] [--steps N]\n"
+    "                [--case dam_break|aortic_root | --scene SCENE.json] [--set KEY=VALUE]...\n"
     "  aortasph --help | --version\n"
     "\n"
     "exit codes: 0 ok, 1 compare: images differ, 2 bad input, 3 unstable simulation, 130 interrupted\n"
@@ -66,28 +67,43 @@ int dispatch(const std::vector<std::string>& args) {
     return cmd_check(scene, sets);
   }
   if (cmd == "bench") {
-    int threads = 0;
-    bool quick = false, render = false;
-    std::string json = "bench.json";
+    BenchOptions o;
+    bool case_given = false;
+    auto positive = [&](std::size_t k) {
+      int v = 0;
+      try {
+        v = std::stoi(rest[k]);
+      } catch (const std::exception&) {
+        v = 0;
+      }
+      if (v < 1) throw InputError(rest[k - 1] + ": expected a positive integer, got " + rest[k]);
+      return v;
+    };
     for (std::size_t k = 0; k < rest.size(); ++k) {
+      const bool has_value = k + 1 < rest.size();
       if (rest[k] == "--quick") {
-        quick = true;
+        o.quick = true;
       } else if (rest[k] == "--render") {
-        render = true;
-      } else if (rest[k] == "--threads" && k + 1 < rest.size()) {
-        try {
-          threads = std::stoi(rest[++k]);
-        } catch (const std::exception&) {
-          threads = 0;
-        }
-        if (threads < 1) throw InputError("--threads: expected a positive integer, got " + rest[k]);
-      } else if (rest[k] == "--json" && k + 1 < rest.size()) {
-        json = rest[++k];
+        o.render = true;
+      } else if (rest[k] == "--threads" && has_value) {
+        o.threads = positive(++k);
+      } else if (rest[k] == "--steps" && has_value) {
+        o.steps = positive(++k);
+      } else if (rest[k] == "--json" && has_value) {
+        o.json = rest[++k];
+      } else if (rest[k] == "--case" && has_value) {
+        o.case_name = rest[++k];
+        case_given = true;
+      } else if (rest[k] == "--scene" && has_value) {
+        o.scene = rest[++k];
+      } else if (rest[k] == "--set" && has_value) {
+        o.sets.push_back(rest[++k]);
       } else {
         throw InputError(rest[k] + ": unknown option for bench");
       }
     }
-    return cmd_bench(threads, quick, render, json);
+    if (o.scene && case_given) throw InputError("bench: --scene and --case exclude each other");
+    return cmd_bench(o);
   }
   if (cmd == "compare") return cmd_compare(rest);
   if (cmd == "movie") return cmd_movie(rest);

@@ -169,3 +169,44 @@ TEST_CASE("cli: check prints bodies, counts, h, dt and cost; --help and --versio
   CHECK(aortasph("frobnicate").code == 2);
   CHECK(aortasph("").code == 2);
 }
+
+TEST_CASE("cli: bench --scene steps any scene and reports particle-steps, phases and peak RSS", "[cli]") {
+  const fs::path dir = scratch("bench");
+  const fs::path scene = write_file(dir, "tiny.json", kGood);
+  const fs::path json = dir / "bench.json";
+  const Result r = aortasph("bench --scene " + scene.string() + " --steps 3 --threads 1 --json " + json.string() +
+                            " --set resolution.spacing=0.008");
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const std::string j = slurp(json);
+  CHECK(j.find("\"scene\": \"tiny\"") != std::string::npos);
+  CHECK(j.find("\"steps\": 3") != std::string::npos);
+  for (const char* key : {"fluid_particle_steps_per_s", "particle_steps_per_s", "peak_rss_bytes",
+                          "peak_rss_bytes_per_fluid_particle", "bytes_per_fluid_particle", "phases_s"})
+    CHECK(j.find(std::string("\"") + key + "\"") != std::string::npos);
+  // The --set took effect: the 0.05 x 0.1 x 0.03 column holds 150 particles at 10 mm (5 x 10 x 3), about
+  // twice as many at 8 mm.
+  const auto fluid_particles = [](const std::string& text) {
+    const std::string key = "\"fluid_particles\": ";
+    const auto at = text.find(key);
+    return at == std::string::npos ? -1.0 : std::stod(text.substr(at + key.size()));
+  };
+  const Result coarse = aortasph("bench --scene " + scene.string() + " --steps 1 --json " + json.string());
+  REQUIRE(coarse.code == 0);
+  CHECK(fluid_particles(slurp(json)) == 150.0);
+  CHECK(fluid_particles(j) > 1.8 * 150.0);
+  // Bad bench arguments exit 2 naming the problem.
+  struct Case {
+    std::string args, expect;
+  };
+  for (const Case& c : std::vector<Case>{{"bench --case nosuch", "nosuch"},
+                                         {"bench --scene " + (dir / "missing.json").string(), "missing.json"},
+                                         {"bench --steps 0", "--steps"},
+                                         {"bench --scene " + scene.string() + " --case aortic_root", "--case"},
+                                         {"bench --set resolution.spacing=0.004", "--set"}}) {
+    const Result b = aortasph(c.args + " --json " + (dir / "x.json").string());
+    INFO(c.args << ": exit " << b.code << ", stderr: " << b.err);
+    CHECK(b.code == 2);
+    CHECK(b.err.find(c.expect) != std::string::npos);
+  }
+}
