@@ -184,8 +184,16 @@ class Loader {
       fail("name", "must be a non-empty name without '/'");
     if (top.has("description")) top.string("description");
 
-    Obj dom(top.raw("domain"), "domain", {"min", "max", "max_leave_fraction"}, allowed);
+    Obj dom(top.raw("domain"), "domain", {"min", "max", "max_leave_fraction", "periodic"}, allowed);
     s.domain = dom.box();
+    const std::vector<std::string> periodic = dom.strings("periodic", std::vector<std::string>{});
+    for (std::size_t k = 0; k < periodic.size(); ++k) {
+      const std::string& a = periodic[k];
+      if (a != "x" && a != "y" && a != "z")
+        fail(index(dom.path("periodic"), k), "unknown axis '" + a + "' (x, y or z)");
+      if (s.periodic[a[0] - 'x']) fail(index(dom.path("periodic"), k), "axis '" + a + "' listed twice");
+      s.periodic[a[0] - 'x'] = true;
+    }
     s.max_leave_fraction = dom.non_negative("max_leave_fraction", 0.0);
     if (s.max_leave_fraction > 1) fail(dom.path("max_leave_fraction"), "must lie in 0..1");
 
@@ -264,7 +272,32 @@ class Loader {
           fail(index("probes", p) + ".name", "duplicate probe name '" + s.probes[p].name + "'");
     }
     if (top.has("render")) render(top.raw("render"), s);
+    check_periodic(s);
     return s;
+  }
+
+  // A periodic scene (domain.periodic; sim/core/periodic.hpp) holds fluid and walls only, and each period
+  // spans at least 2.5 neighbour-search radii (the cell stencil of the search must not wrap onto itself).
+  static void check_periodic(const Scene& s) {
+    if (std::none_of(s.periodic.begin(), s.periodic.end(), [](bool b) { return b; })) return;
+    for (std::size_t b = 0; b < s.bodies.size(); ++b) {
+      const MaterialType t = s.materials[s.bodies[b].material].type;
+      if (t == MaterialType::Elastic || t == MaterialType::Rigid)
+        fail(index("bodies", b) + ".material",
+             "elastic and rigid bodies are not supported in a periodic domain (domain.periodic)");
+    }
+    if (!s.open_boundaries.empty())
+      fail("open_boundaries", "open boundaries are not supported in a periodic domain (domain.periodic)");
+    const double radius = 1.1 * 2.0 * s.smoothing_ratio * s.spacing;  // kernel support plus the lists' skin
+    for (int a = 0; a < 3; ++a) {
+      const double len = s.domain.max[a] - s.domain.min[a];
+      if (s.periodic[a] && len < 2.5 * radius * (1.0 + 1e-9)) {
+        std::ostringstream m;
+        m << "the domain is " << len << " m long along periodic axis " << char('x' + a) << ": at least "
+          << 2.5 * radius << " m (2.5 neighbour-search radii at this spacing) is needed";
+        fail("domain.periodic", m.str());
+      }
+    }
   }
 
  private:

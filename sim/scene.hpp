@@ -250,6 +250,8 @@ struct RenderSettings {
 struct Scene {
   std::string name;
   Box domain;
+  std::array<bool, 3>
+      periodic{};  // periodic axes x, y, z (sim/core/periodic.hpp): the domain's length is the period
   double max_leave_fraction = 0.0;
   double spacing = 0.01;
   double smoothing_ratio = 1.3;  // h = smoothing_ratio * spacing

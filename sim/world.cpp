@@ -60,7 +60,7 @@ World::World(const Scene& scene)
     : scene_(scene),
       kernel_(scene.smoothing_ratio * scene.spacing),
       gravity_(scene.gravity),
-      ctx_{kernel_, fluid_, gravity_, {}, {}} {
+      ctx_{kernel_, fluid_, gravity_, {}, {}, Periodic(scene.domain, scene.periodic)} {
   const double dx = scene_.spacing;
   const double volume = dx * dx * dx;
   std::vector<uint8_t> clamped;  // per particle: elastic and held in place
@@ -166,6 +166,7 @@ World::World(const Scene& scene)
   if (P_.size() > std::numeric_limits<uint32_t>::max() / 4) throw SetupError("too many particles");
 
   // Bodies may touch but not overlap: particles of two bodies closer than half a spacing are an error.
+  nb_.set_periodic(ctx_.periodic);
   nb_.build(P_.x, 0.5 * dx);
   for (std::size_t i = 0; i < P_.size(); ++i)
     for (uint32_t k = nb_.begin(i); k < nb_.end(i); ++k) {
@@ -260,7 +261,7 @@ void World::update_neighbors() {
   } else {
     const std::size_t n = P_.size();
     const double moved2 = parallel_reduce(
-        n, 0.0, [&](std::size_t i) { return (P_.x[i] - x_at_build_[i]).squaredNorm(); },
+        n, 0.0, [&](std::size_t i) { return ctx_.separation(P_.x[i], x_at_build_[i]).squaredNorm(); },
         [](double a, double b) { return std::max(a, b); });
     if (4.0 * moved2 >= skin_ * skin_) build_lists();
   }
@@ -353,10 +354,12 @@ void World::step(double dt) {
 // each output, every 55 steps, a TL-SPH beam gained 500x its energy.
 void World::integrate(double dt) {
   const double kick = kick_length(dt);
+  const Periodic& per = ctx_.periodic;
   parallel_for(P_.size(), [&](std::size_t i) {
     if (P_.kind[i] != Kind::Fluid && P_.kind[i] != Kind::Elastic) return;
     P_.v[i] += kick * P_.a[i];
     P_.x[i] += dt * P_.v[i];
+    if (per.any) per.wrap(P_.x[i]);  // out through one periodic face, in through the other
   });
   struct Extremes {
     double v2 = 0, a2 = 0;

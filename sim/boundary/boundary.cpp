@@ -14,7 +14,7 @@ void boundary_from_fluid(Particles& P, const NeighborSearch& nb, const FluidCont
     for (uint32_t k = nb.begin(w); k < nb.end(w); ++k) {
       const uint32_t f = idx[k];
       if (!fluid_like(P.kind[f])) continue;
-      const Vec3 xwf = P.x[w] - P.x[f];
+      const Vec3 xwf = ctx.separation(P.x[w], P.x[f]);
       const double W = ctx.kernel.W(xwf.norm());
       sum_w += W;
       sum_pw += P.p[f] * W;

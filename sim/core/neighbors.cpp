@@ -61,10 +61,22 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std:
     cell_ *= 1.5;
   }
   origin_ = box.lo;
+  // Periodic axes: the grid spans the period in whole cells of at least radius / 2, so that the cells wrap
+  // round exactly; the stencil of 5 cells must not meet itself (a pair would be listed twice).
+  for (int d = 0; d < 3; ++d) {
+    if (!periodic_.on[d]) continue;
+    dims_[d] = static_cast<int>(std::floor(periodic_.len[d] / (0.5 * radius)));
+    if (dims_[d] < 2 * kReach + 1)
+      throw std::invalid_argument("periodic length shorter than 2.5 search radii");
+    origin_[d] = periodic_.lo[d];
+  }
+  const double cell_size[3] = {periodic_.on[0] ? periodic_.len[0] / dims_[0] : cell_,
+                               periodic_.on[1] ? periodic_.len[1] / dims_[1] : cell_,
+                               periodic_.on[2] ? periodic_.len[2] / dims_[2] : cell_};
   const std::size_t ncell = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
 
   auto cell_coord = [&](const Vec3& p, int d) {
-    const int c = static_cast<int>((p[d] - origin_[d]) / cell_);
+    const int c = static_cast<int>(std::floor((p[d] - origin_[d]) / cell_size[d]));
     return std::clamp(c, 0, dims_[d] - 1);
   };
   parallel_for(n, [&](std::size_t i) {
@@ -100,28 +112,60 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std:
   }
 
   const double r2 = radius * radius;
+  const Periodic& per = periodic_;
+  // The cell rows of the stencil along one axis: [c - kReach, c + kReach], clamped to the grid, or wrapped
+  // round on a periodic axis (there it may fall into two runs, visited in order of the unwrapped offset).
+  struct Runs {
+    int n = 0;
+    int lo[2] = {0, 0}, hi[2] = {0, 0};
+  };
+  auto runs = [&](int c, int d) {
+    Runs r;
+    if (!per.on[d]) {
+      r.n = 1;
+      r.lo[0] = std::max(c - kReach, 0);
+      r.hi[0] = std::min(c + kReach, dims_[d] - 1);
+      return r;
+    }
+    const int a = c - kReach, b = c + kReach, m = dims_[d];
+    if (a < 0) {
+      r = {2, {a + m, 0}, {m - 1, b}};
+    } else if (b >= m) {
+      r = {2, {a, 0}, {m - 1, b - m}};
+    } else {
+      r = {1, {a, 0}, {b, 0}};
+    }
+    return r;
+  };
   // Visit the candidates of i in a fixed order; call found(j) for each neighbour.
   auto visit = [&](std::size_t i, auto&& found) {
     const uint32_t c = cell_of_[i];
     const int cx = static_cast<int>(c % dims_[0]);
     const int cy = static_cast<int>((c / dims_[0]) % dims_[1]);
     const int cz = static_cast<int>(c / (static_cast<std::size_t>(dims_[0]) * dims_[1]));
-    const int x0 = std::max(cx - kReach, 0), x1 = std::min(cx + kReach, dims_[0] - 1);
+    const Runs rx = runs(cx, 0), ry = runs(cy, 1), rz = runs(cz, 2);
     const bool fixed_i = any_fixed && fixed[i];
     const Vec3 xi = x[i];
-    for (int z = std::max(cz - kReach, 0); z <= std::min(cz + kReach, dims_[2] - 1); ++z)
-      for (int y = std::max(cy - kReach, 0); y <= std::min(cy + kReach, dims_[1] - 1); ++y) {
-        const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
-        if (fixed_i &&
-            std::none_of(&cell_moving[row + x0], &cell_moving[row + x1] + 1, [](uint8_t m) { return m; }))
-          continue;
-        // Cells x-2 .. x+2 of one row are contiguous in cell_items_.
-        for (uint32_t k = cell_start_[row + x0]; k < cell_start_[row + x1 + 1]; ++k) {
-          if ((fixed_i && fixed_s[k]) || (xs[k] - xi).squaredNorm() >= r2) continue;
-          const uint32_t j = cell_items_[k];
-          if (j != i) found(j);
-        }
-      }
+    for (int iz = 0; iz < rz.n; ++iz)
+      for (int z = rz.lo[iz]; z <= rz.hi[iz]; ++z)
+        for (int iy = 0; iy < ry.n; ++iy)
+          for (int y = ry.lo[iy]; y <= ry.hi[iy]; ++y) {
+            const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
+            for (int ix = 0; ix < rx.n; ++ix) {
+              const int x0 = rx.lo[ix], x1 = rx.hi[ix];
+              if (fixed_i && std::none_of(&cell_moving[row + x0], &cell_moving[row + x1] + 1,
+                                          [](uint8_t m) { return m; }))
+                continue;
+              // Cells x0 .. x1 of one row are contiguous in cell_items_.
+              for (uint32_t k = cell_start_[row + x0]; k < cell_start_[row + x1 + 1]; ++k) {
+                if (fixed_i && fixed_s[k]) continue;
+                const Vec3 d = per.any ? per.image(xs[k] - xi) : Vec3(xs[k] - xi);
+                if (d.squaredNorm() >= r2) continue;
+                const uint32_t j = cell_items_[k];
+                if (j != i) found(j);
+              }
+            }
+          }
   };
 
   // One pass over fixed, contiguous chunks of particles (their number does not depend on the thread count),

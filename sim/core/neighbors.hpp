@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/periodic.hpp"
 #include "scene.hpp"
 
 namespace aortasph {
@@ -17,7 +18,12 @@ class NeighborSearch {
   // All pairs i != j with |x_i - x_j| < radius, except pairs of two fixed particles (fixed[i] && fixed[j]):
   // fixed walls never interact with each other, and a wall far from anything that moves gets an empty list
   // at almost no cost. fixed may be empty (no fixed particle).
+  // Along periodic axes (set_periodic) the distance is the nearest image's and the cells wrap round; the
+  // grid then spans the domain on those axes, which must hold at least 2 * kReach + 1 = 5 cells of radius / 2
+  // (the loader checks the period; build() throws std::invalid_argument otherwise).
   void build(const std::vector<Vec3>& x, double radius, const std::vector<uint8_t>& fixed = {});
+  void set_periodic(const Periodic& p) { periodic_ = p; }
+  const Periodic& periodic() const { return periodic_; }
 
   std::size_t size() const { return offset_.empty() ? 0 : offset_.size() - 1; }
   uint32_t begin(std::size_t i) const { return offset_[i]; }
@@ -40,6 +46,7 @@ class NeighborSearch {
   std::vector<uint32_t> cell_of_;     // cell index of each particle
   std::vector<uint32_t> cell_start_;  // CSR over cells
   std::vector<uint32_t> cell_items_;
+  Periodic periodic_;
 };
 
 }  // namespace aortasph

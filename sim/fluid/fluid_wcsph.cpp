@@ -14,7 +14,7 @@ void fluid_density_summation(Particles& P, const NeighborSearch& nb, const Fluid
     double rho = P.m[i] * w0;
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
-      rho += P.m[j] * ctx.kernel.W((P.x[i] - P.x[j]).norm());
+      rho += P.m[j] * ctx.kernel.W(ctx.separation(P.x[i], P.x[j]).norm());
     }
     P.rho[i] = rho;
   });
@@ -52,7 +52,7 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
     double drho = 0.0;
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
-      const Vec3 xij = xi - P.x[j];
+      const Vec3 xij = ctx.separation(xi, P.x[j]);
       const double r2 = xij.squaredNorm();
       if (r2 >= support2 || r2 <= 0.0) continue;  // Verlet-list pairs in the skin: the kernel is zero there
       const double r = std::sqrt(r2);
@@ -64,7 +64,7 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
       // Density diffusion (Molteni & Colagrossi 2009, eq. 12) between particles of one fluid, minus the
       // hydrostatic density difference rho0 g.x_ji / c0^2 (Fourtakas et al. 2019, eq. 19, linearised Tait).
       if (diffusion > 0.0 && fluid_like(P.kind[j]) && P.material[j] == P.material[i]) {
-        const double hydro = fi.rho0 * ctx.gravity.dot(P.x[j] - xi) * inv_c2;
+        const double hydro = fi.rho0 * ctx.gravity.dot(-xij) * inv_c2;  // x_j - x_i
         drho -= diffusion * (P.rho[j] - rhoi - hydro) * dwdr_r * ctx.volume[j];
       }
     }
@@ -100,7 +100,7 @@ struct PairConstants {
 
 inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx, const PairConstants& c,
                               const FluidI& I, std::size_t j) {
-  const Vec3 xij = I.x - P.x[j];
+  const Vec3 xij = ctx.separation(I.x, P.x[j]);
   const double r2 = xij.squaredNorm();
   if (r2 >= c.support2 || r2 <= 0.0) return Vec3::Zero();  // Verlet-list pairs in the skin
   const FluidParams& fi = *I.params;

@@ -15,6 +15,7 @@
 #include "core/kernel.hpp"
 #include "core/neighbors.hpp"
 #include "core/particles.hpp"
+#include "core/periodic.hpp"
 
 namespace aortasph {
 
@@ -57,6 +58,11 @@ struct FluidContext {
   // Per-particle factors of the pair sums, computed once per step instead of once per pair.
   std::vector<double> p_over_rho2;  // p / rho^2
   std::vector<double> volume;       // m / rho
+  Periodic periodic;                // periodic axes: pair separations are nearest images
+  // x_i - x_j, or its nearest image along periodic axes.
+  Vec3 separation(const Vec3& xi, const Vec3& xj) const {
+    return periodic.any ? periodic.image(xi - xj) : Vec3(xi - xj);
+  }
 };
 
 // Fills ctx.p_over_rho2 and ctx.volume from the current p and rho.
