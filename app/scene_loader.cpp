@@ -396,7 +396,8 @@ class Loader {
                 "delta_sph",
                 "artificial_viscosity",
                 "density_summation",
-                "background_pressure"};
+                "background_pressure",
+                "shifting"};
       else if (type == "elastic")
         keys = {"type",  "density", "youngs_modulus", "poisson_ratio", "hourglass", "artificial_viscosity",
                 "model", "gradient"};
@@ -414,6 +415,8 @@ class Loader {
         m.artificial_viscosity = o.non_negative("artificial_viscosity", 0.0);
         m.density_summation = o.boolean("density_summation", false);
         m.background_pressure = o.number("background_pressure", 0.0);
+        m.shifting = o.non_negative("shifting", 0.0);
+        if (m.shifting > 10.0) fail(o.path("shifting"), "must lie in 0..10 (Skillen et al. 2013 use 1..6)");
       } else if (type == "elastic") {
         m.type = MaterialType::Elastic;
         m.density = o.positive("density");
@@ -452,7 +455,7 @@ class Loader {
   Body body(json& j, const std::string& path, const Scene& s) {
     Obj o(j, path,
           {"name", "material", "shape", "translate", "rotate", "velocity", "angular_velocity", "color",
-           "render", "fixed"},
+           "render", "fixed", "initial_flow"},
           allowed);
     Body b;
     b.name = o.string("name");
@@ -477,6 +480,13 @@ class Loader {
     }
     b.velocity = o.vec3("velocity", Vec3::Zero());
     b.angular_velocity = o.vec3("angular_velocity", Vec3::Zero());
+    if (o.has("initial_flow")) {
+      if (s.materials[b.material].type != MaterialType::Fluid)
+        fail(o.path("initial_flow"), "only a fluid body takes an initial flow field");
+      Obj f(o.raw("initial_flow"), o.path("initial_flow"), {"taylor_green"}, allowed);
+      Obj tg(f.raw("taylor_green"), f.path("taylor_green"), {"speed", "wavelength"}, allowed);
+      b.taylor_green = InitialFlow{tg.number("speed"), tg.positive("wavelength")};
+    }
     if (o.has("color")) b.color = o.color("color");
     const std::string mode = o.choice("render", {"particles", "surface", "hidden"}, "particles");
     b.render = mode == "surface"  ? RenderMode::Surface

@@ -38,6 +38,7 @@ struct Material {
   double artificial_viscosity = 0.0;  // Monaghan alpha (Monaghan 1992); 0 switches it off
   bool density_summation = false;     // eq. (11) instead of the continuity equation (12)
   double background_pressure = 0.0;   // added to the Tait pressure [Pa]
+  double shifting = 0.0;  // particle shifting coefficient A (sim/fluid/shifting.hpp); 0 switches it off
 
   // Elastic (Total-Lagrangian SPH, paper section 3.2)
   double youngs_modulus = 0.0;
@@ -105,6 +106,15 @@ struct Shape {
 
 enum class RenderMode { Particles, Surface, Hidden };
 
+// An initial flow field of a fluid body (docs/scenes.md, bodies[].initial_flow), added to its uniform
+// velocity. Taylor-Green vortex (Taylor & Green 1937), the 2-D array of counter-rotating vortices in the x-y
+// plane with k = 2 pi / wavelength and x, y measured from domain.min: u = U sin kx cos ky, v = -U cos kx sin
+// ky, with its pressure p = p_b + rho0 U^2 / 4 (cos 2kx + cos 2ky) (the density from the equation of state).
+struct InitialFlow {
+  double speed = 0.0;       // U [m/s]
+  double wavelength = 1.0;  // [m]
+};
+
 struct Body {
   std::string name;
   int material = 0;  // index into Scene::materials
@@ -116,7 +126,8 @@ struct Body {
   Vec3 angular_velocity = Vec3::Zero();
   std::optional<Vec3> color;  // rgb in 0..1
   RenderMode render = RenderMode::Particles;
-  std::optional<Box> fixed;  // elastic bodies: particles inside are clamped
+  std::optional<Box> fixed;                 // elastic bodies: particles inside are clamped
+  std::optional<InitialFlow> taylor_green;  // fluid bodies: initial_flow.taylor_green
 };
 
 struct Contact {

@@ -9,6 +9,7 @@
 #include "boundary/boundary.hpp"
 #include "core/parallel.hpp"
 #include "core/sim_errors.hpp"
+#include "fluid/shifting.hpp"
 #include "geometry/shapes.hpp"
 
 namespace aortasph {
@@ -76,6 +77,7 @@ World::World(const Scene& scene)
     have_fluid = true;
     max_c0_ = std::max(max_c0_, mat.sound_speed);
     max_nu_ = std::max(max_nu_, mat.viscosity);
+    shifting_ = shifting_ || mat.shifting > 0.0;
   }
   if (!have_fluid) wall_ref_ = FluidParams(Material{});
 
@@ -118,6 +120,19 @@ World::World(const Scene& scene)
       P_.rho[i] = rho0;
       if (mat.type != MaterialType::Wall)
         P_.v[i] = body.velocity + body.angular_velocity.cross(sample.points[k] - centroid);
+    }
+    if (body.taylor_green && mat.type == MaterialType::Fluid) {
+      const InitialFlow& tg = *body.taylor_green;
+      const FluidParams fp(mat);
+      const double k = 2.0 * M_PI / tg.wavelength;
+      for (std::size_t i = first; i < P_.size(); ++i) {
+        const double x = k * (P_.x[i].x() - scene_.domain.min.x()),
+                     y = k * (P_.x[i].y() - scene_.domain.min.y());
+        P_.v[i] += tg.speed * Vec3(std::sin(x) * std::cos(y), -std::cos(x) * std::sin(y), 0.0);
+        const double p =
+            fp.p_background + 0.25 * mat.density * tg.speed * tg.speed * (std::cos(2 * x) + std::cos(2 * y));
+        P_.rho[i] = fp.density(p);
+      }
     }
 
     // Elastic particles held at their reference position: the scene's fixed region and what the shape
@@ -324,6 +339,7 @@ void World::step(double dt) {
   profile_.rigid += seconds_since(t0);
 
   t0 = Clock::now();
+  if (shifting_) fluid_shifting(P_, nb_, ctx_, scene_.spacing, dt, shift_);  // Lind et al. 2012
   integrate(dt);
   profile_.integrate += seconds_since(t0);
 
@@ -359,6 +375,7 @@ void World::integrate(double dt) {
     if (P_.kind[i] != Kind::Fluid && P_.kind[i] != Kind::Elastic) return;
     P_.v[i] += kick * P_.a[i];
     P_.x[i] += dt * P_.v[i];
+    if (!shift_.empty()) P_.x[i] += shift_[i];
     if (per.any) per.wrap(P_.x[i]);  // out through one periodic face, in through the other
   });
   struct Extremes {

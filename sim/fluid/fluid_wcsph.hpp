@@ -29,6 +29,7 @@ struct FluidParams {
   double delta = 0.0;
   double alpha = 0.0;
   double p_background = 0.0;
+  double shifting = 0.0;  // particle shifting coefficient A (fluid/shifting.hpp)
   bool summation = false;
 
   explicit FluidParams(const Material& m)
@@ -40,6 +41,7 @@ struct FluidParams {
         delta(m.delta_sph),
         alpha(m.artificial_viscosity),
         p_background(m.background_pressure),
+        shifting(m.shifting),
         summation(m.density_summation) {}
   FluidParams() = default;
 

@@ -1,0 +1,33 @@
+// Particle shifting for the fluid (issue 20): a small displacement per step that moves fluid particles down
+// the gradient of their own concentration, so that they stay evenly spaced where plain WCSPH lets them string
+// out and clump (stagnation points, expanding flows: the tensile instability). Fickian form of Lind, Xu,
+// Stansby & Rogers 2012 (J. Comput. Phys. 231:1499-1523, eqs. 13-18) with the diffusion coefficient of
+// Skillen, Lind, Stansby & Rogers 2013 (Comput. Methods Appl. Mech. Engrg. 265:163-173):
+//
+//   dr_i = -D_i grad C_i,   D_i = A h |v_i| dt,
+//   grad C_i = sum_j V_j [1 + R (W_ij / W(dx))^n] grad_i W_ij   (R = 0.2, n = 4: Monaghan 2000's
+//              anti-clumping term, which Lind et al. add so that pairs closer than dx repel more),
+//
+// over all neighbours (fluid, buffers and boundary particles, which complete the concentration field next to
+// walls). A is the material's `shifting` coefficient (0: off; Skillen et al. use 1..6, 2 is the common
+// choice). Near a free surface the concentration drops for want of neighbours, not for disorder: where the
+// particle's kernel divergence of position, div r_i = -sum_j V_j grad_i W_ij . x_ij (3 in the bulk in 3-D),
+// is under 2.5, only the part of dr tangent to the surface (normal -grad C / |grad C|) is kept, and under 1.5
+// (a splash) none (Lind et al. 2012 sec. 3.3 treat the surface the same way, with 2-D thresholds). A shift is
+// capped at 0.1 dx per step. The quantities carried by the particle (velocity, density) are not
+// Taylor-corrected for the shift (as in the Fickian WCSPH schemes of Skillen et al.); mass and momentum are
+// untouched, so they stay conserved exactly.
+#pragma once
+
+#include <vector>
+
+#include "fluid/fluid_wcsph.hpp"
+
+namespace aortasph {
+
+// Shift of every fluid particle whose material has shifting > 0 (zero for the others), from the positions
+// and velocities now, for a step of dt. Gathers: each particle writes only its own entry.
+void fluid_shifting(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx, double dx,
+                    double dt, std::vector<Vec3>& shift);
+
+}  // namespace aortasph
