@@ -16,6 +16,7 @@
 #include "commands.hpp"
 #include "core/parallel.hpp"
 #include "core/sim_errors.hpp"
+#include "cycle_report.hpp"
 #include "errors.hpp"
 #include "frames.hpp"
 #include "geometry/aortic_root.hpp"
@@ -299,6 +300,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   const auto wall_start = Clock::now();
   World world(scene);
   ProbeSet probes(scene, world);  // resolved on the state at t = 0, as in the run that wrote the checkpoint
+  check_cycle_columns(scene, probes.columns());
   if (resume) world.load_state(*resume);
   std::optional<CsvWriter> probe_csv, diag_csv;
   std::optional<VtkWriter> vtk;
@@ -334,12 +336,32 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
                  threads, dir.string().c_str(),
                  resume ? (" (resumed at t = " + format_number(world.time()) + " s)").c_str() : "");
 
+  // Cycle metrics (scene block `cycle`): after each output that completes a cycle, every complete cycle is
+  // measured again from probes.csv (so a resumed run counts the rows before the checkpoint too), cycles.csv
+  // rewritten and the new cycles reported on standard output.
+  std::vector<CycleMetrics> cycles;
+  std::size_t cycles_reported = 0;
+  auto update_cycles = [&]() {
+    if (!scene.cycle) return;
+    cycles = cycle_metrics_of(scene, read_csv(dir / "probes.csv"));
+    write_cycles_csv(dir / "cycles.csv", cycles);
+    for (; cycles_reported < cycles.size(); ++cycles_reported)
+      std::printf("aortasph: %s\n", cycle_line(cycles[cycles_reported]).c_str());
+    std::fflush(stdout);
+  };
+  double next_cycle_end = scene.cycle ? scene.cycle->start + scene.cycle->period : 0.0;
+
   int frame = first_frame;
   auto output = [&]() {
     std::vector<double> row{world.time()};
     const auto values = probes.measure(world);
     row.insert(row.end(), values.begin(), values.end());
     probe_csv->row(row);
+    if (scene.cycle && world.time() >= next_cycle_end - 1e-9 * scene.cycle->period) {
+      while (next_cycle_end <= world.time() + 1e-9 * scene.cycle->period)
+        next_cycle_end += scene.cycle->period;
+      update_cycles();
+    }
     diag_csv->row(diagnostics_row(world));
     if (vtk) vtk->write(world, frame);
     if (frames) frames->push(world, frame);
@@ -395,6 +417,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     j["timings_s"] = {{"setup", setup_seconds},
                       {"wall", std::chrono::duration<double>(Clock::now() - wall_start).count()}};
     for (const auto& [name, sec] : world.profile().phases()) j["timings_s"][name] = sec;
+    if (scene.cycle) j["cycles"] = cycles_json(scene, cycles);
     std::ofstream f(dir / "run.json", std::ios::trunc);
     f << std::setw(2) << j << '\n';
     f.close();
@@ -446,7 +469,17 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
       write_run_json("interrupted", "");
       code = 130;
     } else {
+      update_cycles();
       write_run_json("ok", "");
+      // The Wiggers plot of a run with a cycle block; a missing python3 / matplotlib is a warning here (the
+      // run's results stand) and an error for `aortasph plot`.
+      if (scene.cycle) {
+        std::string error;
+        if (make_wiggers_plot(dir, error) != 0)
+          std::fprintf(stderr,
+                       "aortasph: warning: no Wiggers plot: %s (make it later with: aortasph plot %s)\n",
+                       error.c_str(), dir.string().c_str());
+      }
     }
   } catch (const InstabilityError& e) {
     progress.done();
@@ -570,6 +603,7 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
   const Scene& scene = loaded.scene;
   validate_render(scene);
   const World world(scene);
+  check_cycle_columns(scene, ProbeSet(scene, world).columns());
   std::printf("scene %s: spacing %g m, h = %g m (ratio %g), domain [%g %g %g] .. [%g %g %g]\n",
               scene.name.c_str(), scene.spacing, world.kernel().h, scene.smoothing_ratio,
               scene.domain.min.x(), scene.domain.min.y(), scene.domain.min.z(), scene.domain.max.x(),
