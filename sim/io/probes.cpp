@@ -73,15 +73,6 @@ GapStats body_gap(const World& world, const std::vector<int>& bodies) {
   return g;
 }
 
-// The nearest-rank percentile (the ceil(q/100 n)-th smallest value); 0 for no value.
-double percentile_nearest_rank(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  const std::size_t rank = static_cast<std::size_t>(std::ceil(q / 100.0 * static_cast<double>(v.size())));
-  const std::size_t k = std::min(v.size() - 1, rank > 0 ? rank - 1 : 0);
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
 // Largest eigenvalue of the Green-Lagrange strain E = (F^T F - I) / 2 (paper eq. 15).
 double largest_principal_strain(const Eigen::Matrix3d& F) {
   const Eigen::Matrix3d E = 0.5 * (F.transpose() * F - Eigen::Matrix3d::Identity());
@@ -165,6 +156,14 @@ void add_columns(std::vector<std::string>& cols, const std::string& name,
 }
 
 }  // namespace
+
+double percentile_nearest_rank(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const std::size_t rank = static_cast<std::size_t>(std::ceil(q / 100.0 * static_cast<double>(v.size())));
+  const std::size_t k = std::min(v.size() - 1, rank > 0 ? rank - 1 : 0);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
 
 std::vector<std::string> coaptation_columns(std::size_t leaflets) {
   std::vector<std::string> cols;
