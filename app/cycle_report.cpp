@@ -293,11 +293,11 @@ int make_wiggers_plot(const fs::path& dir, std::string& error) {
     return 2;
   }
   const fs::path run_json = dir / "run.json", probes = dir / "probes.csv", cycles = dir / "cycles.csv";
-  for (const fs::path& f : {run_json, probes, cycles})
-    if (!fs::is_regular_file(f, ec)) {
-      error = f.string() + ": missing (not the folder of a finished run with a cycle block?)";
-      return 2;
-    }
+  auto missing = [&](const fs::path& f) {
+    error = f.string() + ": missing (not the folder of a finished run?)";
+    return 2;
+  };
+  if (!fs::is_regular_file(run_json, ec)) return missing(run_json);
   Scene scene;
   try {
     std::ifstream in(run_json);
@@ -306,21 +306,32 @@ int make_wiggers_plot(const fs::path& dir, std::string& error) {
       error = run_json.string() + ": not a run.json (no scene)";
       return 2;
     }
-    scene = load_scene_json(j["scene"], {}).scene;
-    if (!scene.cycle) {
-      error = run_json.string() + ": the run's scene has no cycle block (docs/scenes.md \"cycle\")";
-      return 2;
-    }
+    // The render block is not needed here (and a run with --end-time may hold figure times past its end).
+    nlohmann::json recorded = j["scene"];
+    recorded.erase("render");
+    scene = load_scene_json(recorded, {}).scene;
+  } catch (const InputError& e) {
+    error = run_json.string() + ": its scene: " + e.what();
+    return 2;
+  }
+  if (!scene.cycle) {
+    error = run_json.string() + ": the run's scene has no cycle block (docs/scenes.md \"cycle\")";
+    return 2;
+  }
+  if (!fs::is_regular_file(probes, ec)) return missing(probes);
+  if (!fs::is_regular_file(cycles, ec)) return missing(cycles);
+  try {
     const CsvTable table = read_csv(probes);
-    std::vector<std::string> columns(table.header.begin() + (table.header.empty() ? 0 : 1),
-                                     table.header.end());
+    const std::vector<std::string> columns(table.header.begin() + 1, table.header.end());
     check_cycle_columns(scene, columns);
     if (table.rows.size() < 2) {
       error = probes.string() + ": fewer than two rows";
       return 2;
     }
+    read_csv(cycles);
   } catch (const InputError& e) {
-    error = std::string(probes.string()) + ": " + e.what();
+    const std::string what = e.what();
+    error = what.rfind("cycle.", 0) == 0 ? probes.string() + ": " + what : what;
     return 2;
   }
   const std::string python = find_python();

@@ -341,8 +341,10 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   // rewritten and the new cycles reported on standard output.
   std::vector<CycleMetrics> cycles;
   std::size_t cycles_reported = 0;
+  bool cycles_changed = false;  // run.json is rewritten after an output that completed a cycle
   auto update_cycles = [&]() {
     if (!scene.cycle) return;
+    cycles_changed = true;
     cycles = cycle_metrics_of(scene, read_csv(dir / "probes.csv"));
     write_cycles_csv(dir / "cycles.csv", cycles);
     for (; cycles_reported < cycles.size(); ++cycles_reported)
@@ -451,6 +453,10 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
       });
       if (!reached) break;  // interrupted between outputs: no partial row, everything before stays valid
       output();
+      if (cycles_changed) {
+        write_run_json("running", "");
+        cycles_changed = false;
+      }
       if (rec.checkpoint_every > 0.0 && world.time() >= rec.next_checkpoint && !g_interrupted) {
         while (rec.next_checkpoint <= world.time()) rec.next_checkpoint += rec.checkpoint_every;
         write_checkpoint();
@@ -669,6 +675,13 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
       "  cost estimate: %.3g s per step, about %s on %d thread(s) without rendering; memory about %.0f MB\n",
       step_2threads * 2.0 / threads, hms(seconds).c_str(), threads,
       static_cast<double>(world.memory_bytes()) / 1e6);
+  if (scene.cycle) {
+    std::string cols;
+    for (const auto& [key, col] : cycle_columns(scene)) cols += " " + key.substr(6) + "=" + col;
+    std::printf("  cycle: period %g s, %zu complete cycle(s) to t = %g s;%s\n", scene.cycle->period,
+                cycle_windows(scene.t_end, {scene.cycle->period, scene.cycle->start}).size(), scene.t_end,
+                cols.c_str());
+  }
   std::printf("  outputs: %ld (every %g s), probes: %zu, cameras: %zu\n",
               static_cast<long>(std::floor(scene.t_end / scene.output_interval + 1e-9)) + 1,
               scene.output_interval, scene.probes.size(), scene.render.cameras.size());
