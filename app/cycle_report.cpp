@@ -302,7 +302,7 @@ int make_wiggers_plot(const fs::path& dir, std::string& error) {
   try {
     std::ifstream in(run_json);
     const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-    if (j.is_discarded() || !j.contains("scene")) {
+    if (j.is_discarded() || !j.is_object() || !j.contains("scene") || !j["scene"].is_object()) {
       error = run_json.string() + ": not a run.json (no scene)";
       return 2;
     }

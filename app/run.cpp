@@ -352,6 +352,13 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     std::fflush(stdout);
   };
   double next_cycle_end = scene.cycle ? scene.cycle->start + scene.cycle->period : 0.0;
+  if (resume && scene.cycle) {
+    // The cycles completed before the checkpoint were reported by the interrupted run (probes.csv holds
+    // their rows): measured again for run.json, not printed again.
+    while (next_cycle_end <= world.time() + 1e-9 * scene.cycle->period) next_cycle_end += scene.cycle->period;
+    cycles = cycle_metrics_of(scene, read_csv(dir / "probes.csv"));
+    cycles_reported = cycles.size();
+  }
 
   int frame = first_frame;
   auto output = [&]() {
