@@ -1,6 +1,8 @@
 // Valve metrics per cardiac cycle (issue 17 items 4-6; docs/valve-metrics.md): the metrics on synthetic time
 // series with known answers, the probes they read (coaptation, stress percentile), a short run with a cycle
 // block (cycles.csv, run.json, the Wiggers plot) and bad cycle blocks.
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -319,4 +321,54 @@ TEST_CASE("cycle block: bad input exits 2 naming the JSON path", "[physiology][b
   cycle.erase("cycles");
   CHECK(run_cli("check " + tube_cycle_scene(dir, cycle).string(), err) == 2);
   CHECK(err.find("time.end: missing") != std::string::npos);
+}
+
+TEST_CASE("stress probe: 95th percentile and peak strain of a sagging cantilever", "[physiology]") {
+  // A clamped rubber beam sagging under gravity: its leaflet-style stress columns after 20 ms.
+  Scene s;
+  s.name = "beam";
+  s.spacing = 0.005;
+  s.gravity = Vec3(0, -9.81, 0);
+  s.domain = {Vec3(-1, -1, -1), Vec3(2, 1, 1)};
+  Material rubber;
+  rubber.name = "rubber";
+  rubber.type = MaterialType::Elastic;
+  rubber.density = 1000.0;
+  rubber.youngs_modulus = 2e4;
+  rubber.poisson_ratio = 0.3;
+  s.materials = {rubber};
+  Body b;
+  b.name = "beam";
+  b.material = 0;
+  b.shape.kind = ShapeKind::Box;
+  b.shape.box = {Vec3(-0.01, 0, 0), Vec3(0.08, 0.01, 0.01)};
+  b.fixed = Box{Vec3(-1, -1, -1), Vec3(0, 1, 1)};
+  s.bodies = {b};
+  Probe p;
+  p.name = "st";
+  p.type = ProbeType::Stress;
+  p.bodies = {0};
+  s.probes = {p};
+  World w(s);
+  const ProbeSet probes(s, w);
+  REQUIRE(probes.columns() == std::vector<std::string>{"st.max", "st.mean", "st.p95", "st.strain_max"});
+  w.advance_to(0.02, [] { return true; });
+  const auto v = probes.measure(w);
+  INFO("max " << v[0] << " Pa, mean " << v[1] << " Pa, p95 " << v[2] << " Pa, strain " << v[3]);
+  CHECK(v[0] > 0.0);
+  CHECK(v[2] > 0.0);
+  CHECK(v[2] <= v[0]);
+  // The percentile against the particles' values, and the strain against E = (F^T F - I) / 2 of each one.
+  const Solids& S = w.solids();
+  std::vector<double> vm;
+  double strain = 0.0;
+  for (std::size_t k = 0; k < S.size(); ++k) {
+    vm.push_back(S.von_mises(k));
+    const Eigen::Matrix3d E = 0.5 * (S.F(k).transpose() * S.F(k) - Eigen::Matrix3d::Identity());
+    strain = std::max(strain, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(E).eigenvalues().maxCoeff());
+  }
+  std::sort(vm.begin(), vm.end());
+  CHECK(v[2] == vm[static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(vm.size()))) - 1]);
+  CHECK(v[3] == Approx(strain).epsilon(1e-12));
+  CHECK(v[3] > 0.0);
 }
