@@ -329,7 +329,7 @@ TEST_CASE("stress probe: 95th percentile and peak strain of a sagging cantilever
   s.name = "beam";
   s.spacing = 0.005;
   s.gravity = Vec3(0, -9.81, 0);
-  s.domain = {Vec3(-1, -1, -1), Vec3(2, 1, 1)};
+  s.domain = {Vec3(-0.02, -0.05, -0.02), Vec3(0.1, 0.03, 0.03)};  // small: a small cell grid
   Material rubber;
   rubber.name = "rubber";
   rubber.type = MaterialType::Elastic;
@@ -342,7 +342,7 @@ TEST_CASE("stress probe: 95th percentile and peak strain of a sagging cantilever
   b.material = 0;
   b.shape.kind = ShapeKind::Box;
   b.shape.box = {Vec3(-0.01, 0, 0), Vec3(0.08, 0.01, 0.01)};
-  b.fixed = Box{Vec3(-1, -1, -1), Vec3(0, 1, 1)};
+  b.fixed = Box{Vec3(-0.02, -0.05, -0.02), Vec3(0, 0.03, 0.03)};
   s.bodies = {b};
   Probe p;
   p.name = "st";
@@ -354,6 +354,7 @@ TEST_CASE("stress probe: 95th percentile and peak strain of a sagging cantilever
   REQUIRE(probes.columns() == std::vector<std::string>{"st.max", "st.mean", "st.p95", "st.strain_max"});
   w.advance_to(0.02, [] { return true; });
   const auto v = probes.measure(w);
+  INFO("steps " << w.steps() << ", dt " << w.last_dt());
   INFO("max " << v[0] << " Pa, mean " << v[1] << " Pa, p95 " << v[2] << " Pa, strain " << v[3]);
   CHECK(v[0] > 0.0);
   CHECK(v[2] > 0.0);
