@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "core/sim_errors.hpp"
+#include "cycle_report.hpp"
 #include "errors.hpp"
 #include "render_commands.hpp"
 
@@ -23,6 +24,8 @@ const char* kUsage =
     "  aortasph check SCENE.json [--set KEY=VALUE]...   validate and print bodies, counts, h, dt, cost\n"
     "  aortasph compare A B [--diff DIFF.png] [--tolerance T]\n"
     "  aortasph movie DIR [--fps N]\n"
+    "  aortasph plot DIR                                Wiggers plot (DIR/figures/wiggers.png) of a run\n"
+    "                                                   with a cycle block (needs python3-matplotlib)\n"
     "  aortasph bench [--threads N] [--quick] [--render] [--json FILE] [--steps N]\n"
     "                [--case dam_break|aortic_root | --scene SCENE.json] [--set KEY=VALUE]...\n"
     "  aortasph --help | --version\n"
@@ -107,6 +110,7 @@ int dispatch(const std::vector<std::string>& args) {
   }
   if (cmd == "compare") return cmd_compare(rest);
   if (cmd == "movie") return cmd_movie(rest);
+  if (cmd == "plot") return cmd_plot(rest);
   throw InputError(cmd + ": unknown command (see aortasph --help)");
 }
 

@@ -16,6 +16,7 @@
 #include "commands.hpp"
 #include "core/parallel.hpp"
 #include "core/sim_errors.hpp"
+#include "cycle_report.hpp"
 #include "errors.hpp"
 #include "frames.hpp"
 #include "geometry/aortic_root.hpp"
@@ -299,6 +300,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   const auto wall_start = Clock::now();
   World world(scene);
   ProbeSet probes(scene, world);  // resolved on the state at t = 0, as in the run that wrote the checkpoint
+  check_cycle_columns(scene, probes.columns());
   if (resume) world.load_state(*resume);
   std::optional<CsvWriter> probe_csv, diag_csv;
   std::optional<VtkWriter> vtk;
@@ -334,12 +336,41 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
                  threads, dir.string().c_str(),
                  resume ? (" (resumed at t = " + format_number(world.time()) + " s)").c_str() : "");
 
+  // Cycle metrics (scene block `cycle`): after each output that completes a cycle, every complete cycle is
+  // measured again from probes.csv (so a resumed run counts the rows before the checkpoint too), cycles.csv
+  // rewritten and the new cycles reported on standard output.
+  std::vector<CycleMetrics> cycles;
+  std::size_t cycles_reported = 0;
+  bool cycles_changed = false;  // run.json is rewritten after an output that completed a cycle
+  auto update_cycles = [&]() {
+    if (!scene.cycle) return;
+    cycles_changed = true;
+    cycles = cycle_metrics_of(scene, read_csv(dir / "probes.csv"));
+    write_cycles_csv(dir / "cycles.csv", cycles);
+    for (; cycles_reported < cycles.size(); ++cycles_reported)
+      std::printf("aortasph: %s\n", cycle_line(cycles[cycles_reported]).c_str());
+    std::fflush(stdout);
+  };
+  double next_cycle_end = scene.cycle ? scene.cycle->start + scene.cycle->period : 0.0;
+  if (resume && scene.cycle) {
+    // The cycles completed before the checkpoint were reported by the interrupted run (probes.csv holds
+    // their rows): measured again for run.json, not printed again.
+    while (next_cycle_end <= world.time() + 1e-9 * scene.cycle->period) next_cycle_end += scene.cycle->period;
+    cycles = cycle_metrics_of(scene, read_csv(dir / "probes.csv"));
+    cycles_reported = cycles.size();
+  }
+
   int frame = first_frame;
   auto output = [&]() {
     std::vector<double> row{world.time()};
     const auto values = probes.measure(world);
     row.insert(row.end(), values.begin(), values.end());
     probe_csv->row(row);
+    if (scene.cycle && world.time() >= next_cycle_end - 1e-9 * scene.cycle->period) {
+      while (next_cycle_end <= world.time() + 1e-9 * scene.cycle->period)
+        next_cycle_end += scene.cycle->period;
+      update_cycles();
+    }
     diag_csv->row(diagnostics_row(world));
     if (vtk) vtk->write(world, frame);
     if (frames) frames->push(world, frame);
@@ -395,6 +426,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     j["timings_s"] = {{"setup", setup_seconds},
                       {"wall", std::chrono::duration<double>(Clock::now() - wall_start).count()}};
     for (const auto& [name, sec] : world.profile().phases()) j["timings_s"][name] = sec;
+    if (scene.cycle) j["cycles"] = cycles_json(scene, cycles);
     std::ofstream f(dir / "run.json", std::ios::trunc);
     f << std::setw(2) << j << '\n';
     f.close();
@@ -428,6 +460,10 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
       });
       if (!reached) break;  // interrupted between outputs: no partial row, everything before stays valid
       output();
+      if (cycles_changed) {
+        write_run_json("running", "");
+        cycles_changed = false;
+      }
       if (rec.checkpoint_every > 0.0 && world.time() >= rec.next_checkpoint && !g_interrupted) {
         while (rec.next_checkpoint <= world.time()) rec.next_checkpoint += rec.checkpoint_every;
         write_checkpoint();
@@ -446,7 +482,17 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
       write_run_json("interrupted", "");
       code = 130;
     } else {
+      update_cycles();
       write_run_json("ok", "");
+      // The Wiggers plot of a run with a cycle block; a missing python3 / matplotlib is a warning here (the
+      // run's results stand) and an error for `aortasph plot`.
+      if (scene.cycle) {
+        std::string error;
+        if (make_wiggers_plot(dir, error) != 0)
+          std::fprintf(stderr,
+                       "aortasph: warning: no Wiggers plot: %s (make it later with: aortasph plot %s)\n",
+                       error.c_str(), dir.string().c_str());
+      }
     }
   } catch (const InstabilityError& e) {
     progress.done();
@@ -570,6 +616,7 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
   const Scene& scene = loaded.scene;
   validate_render(scene);
   const World world(scene);
+  check_cycle_columns(scene, ProbeSet(scene, world).columns());
   std::printf("scene %s: spacing %g m, h = %g m (ratio %g), domain [%g %g %g] .. [%g %g %g]\n",
               scene.name.c_str(), scene.spacing, world.kernel().h, scene.smoothing_ratio,
               scene.domain.min.x(), scene.domain.min.y(), scene.domain.min.z(), scene.domain.max.x(),
@@ -635,6 +682,13 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
       "  cost estimate: %.3g s per step, about %s on %d thread(s) without rendering; memory about %.0f MB\n",
       step_2threads * 2.0 / threads, hms(seconds).c_str(), threads,
       static_cast<double>(world.memory_bytes()) / 1e6);
+  if (scene.cycle) {
+    std::string cols;
+    for (const auto& [key, col] : cycle_columns(scene)) cols += " " + key.substr(6) + "=" + col;
+    std::printf("  cycle: period %g s, %zu complete cycle(s) to t = %g s;%s\n", scene.cycle->period,
+                cycle_windows(scene.t_end, {scene.cycle->period, scene.cycle->start}).size(), scene.t_end,
+                cols.c_str());
+  }
   std::printf("  outputs: %ld (every %g s), probes: %zu, cameras: %zu\n",
               static_cast<long>(std::floor(scene.t_end / scene.output_interval + 1e-9)) + 1,
               scene.output_interval, scene.probes.size(), scene.render.cameras.size());

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -177,7 +178,7 @@ class Loader {
     Scene s;
     Obj top(root, "",
             {"name", "description", "domain", "resolution", "time", "gravity", "materials", "contact",
-             "aortic_root", "bodies", "open_boundaries", "probes", "render"},
+             "aortic_root", "bodies", "open_boundaries", "probes", "cycle", "render"},
             allowed);
     s.name = top.string("name");
     if (s.name.empty() || s.name.find('/') != std::string::npos || s.name == "." || s.name == "..")
@@ -206,6 +207,11 @@ class Loader {
     Obj time(top.raw("time"), "time",
              {"end", "output_interval", "cfl", "max_dt", "max_speed", "max_density_error", "fixed_dt"},
              allowed);
+    // Without time.end, a cycle block with `cycles` sets the run's length (docs/scenes.md "cycle").
+    if (!time.has("end") && top.has("cycle")) {
+      if (const auto end = cycle_end(top.raw("cycle"))) root["time"]["end"] = *end;
+    }
+    if (!time.has("end")) fail(time.path("end"), "missing (expected a number; or give cycle.cycles)");
     s.t_end = time.positive("end");
     s.output_interval = time.positive("output_interval");
     s.cfl = time.positive("cfl", 0.25);
@@ -271,6 +277,7 @@ class Loader {
         if (s.probes[q].name == s.probes[p].name)
           fail(index("probes", p) + ".name", "duplicate probe name '" + s.probes[p].name + "'");
     }
+    if (top.has("cycle")) s.cycle = cycle(top.raw("cycle"), s);
     if (top.has("render")) render(top.raw("render"), s);
     check_periodic(s);
     return s;
@@ -656,13 +663,16 @@ class Loader {
     if (type == "flow_rate") keys.insert(keys.end(), {"point", "normal", "radius"});
     if (type == "orifice_area") keys.insert(keys.end(), {"body", "bodies", "point", "normal", "radius"});
     if (type == "stress" || type == "gap") keys.insert(keys.end(), {"bodies"});
+    if (type == "max_speed") keys.insert(keys.end(), {"bodies", "region"});
+    if (type == "coaptation")
+      keys.insert(keys.end(), {"bodies", "point", "normal", "distance", "central_radius"});
     Obj o(j, path, keys, allowed);
     Probe p;
     p.name = o.string("name");
     if (p.name.empty() || p.name.find_first_of(",\"\n") != std::string::npos)
       fail(o.path("name"), "must be a non-empty name without commas or quotes");
     o.choice("type", {"extent", "pressure", "body", "point", "energy", "momentum", "flow_rate",
-                      "orifice_area", "open_boundary", "stress", "gap"});
+                      "orifice_area", "open_boundary", "stress", "gap", "max_speed", "coaptation"});
     if (type == "extent") {
       p.type = ProbeType::Extent;
       const auto names = o.strings("bodies");
@@ -707,6 +717,33 @@ class Loader {
         if (s.materials[s.bodies[p.bodies.back()].material].type != MaterialType::Elastic)
           fail(index(o.path("bodies"), k), "body '" + names[k] + "' is not elastic: it carries no stress");
       }
+    } else if (type == "max_speed") {
+      p.type = ProbeType::MaxSpeed;
+      const auto names = o.strings("bodies", std::vector<std::string>{});
+      for (std::size_t k = 0; k < names.size(); ++k) {
+        p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
+        if (s.materials[s.bodies[p.bodies.back()].material].type != MaterialType::Fluid)
+          fail(index(o.path("bodies"), k), "body '" + names[k] + "' is not a fluid");
+      }
+      if (o.has("region")) {
+        Obj r(o.raw("region"), o.path("region"), {"min", "max"}, allowed);
+        p.region = r.box();
+      }
+    } else if (type == "coaptation") {
+      p.type = ProbeType::Coaptation;
+      const auto names = o.strings("bodies");
+      if (names.size() < 2) fail(o.path("bodies"), "expected at least two leaflets");
+      if (names.size() > 16) fail(o.path("bodies"), "expected at most 16 leaflets");
+      for (std::size_t k = 0; k < names.size(); ++k) {
+        p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
+        for (std::size_t l = 0; l < k; ++l)
+          if (p.bodies[l] == p.bodies.back())
+            fail(index(o.path("bodies"), k), "body '" + names[k] + "' listed twice");
+      }
+      p.point = o.vec3("point");
+      p.normal = o.unit("normal");
+      p.distance = o.positive("distance", 1.5 * s.spacing);
+      p.central_radius = o.positive("central_radius", 2.0 * s.spacing);
     } else if (type == "gap") {
       p.type = ProbeType::Gap;
       const auto names = o.strings("bodies");
@@ -742,6 +779,88 @@ class Loader {
       }
     }
     return p;
+  }
+
+  // time.end from a cycle block with `cycles` (start + cycles x period), or nothing.
+  std::optional<double> cycle_end(json& j) {
+    if (!j.is_object() || !j.contains("cycles")) return std::nullopt;
+    Obj o(j, "cycle", cycle_keys(), allowed);
+    const double period = o.positive("period");
+    const int cycles = o.integer("cycles", std::nullopt, 1, 100000);
+    return o.non_negative("start", 0.0) + cycles * period;
+  }
+
+  static std::vector<std::string> cycle_keys() {
+    return {"period",     "cycles",       "start",     "lv_pressure", "aortic_pressure",
+            "valve_flow", "orifice_area", "jet_speed", "lvot_flow",   "lvot_area",
+            "stress",     "coaptation",   "hold_level"};
+  }
+
+  // The probe a column name belongs to: a probe `name` writes the column `name` (one-column probes) or
+  // `name.field`. The exact field list is checked against the probes' columns before a run starts
+  // (check_cycle_columns in app/run.cpp).
+  static const Probe* column_probe(const Scene& s, const std::string& column) {
+    const Probe* best = nullptr;
+    for (const Probe& p : s.probes)
+      if (column == p.name || (column.size() > p.name.size() + 1 &&
+                               column.compare(0, p.name.size(), p.name) == 0 && column[p.name.size()] == '.'))
+        if (!best || p.name.size() > best->name.size()) best = &p;
+    return best;
+  }
+
+  // The cycle block (docs/scenes.md "cycle"): the period and the probe columns of the valve metrics.
+  CycleSpec cycle(json& j, const Scene& s) {
+    Obj o(j, "cycle", cycle_keys(), allowed);
+    CycleSpec c;
+    c.period = o.positive("period");
+    if (o.has("cycles")) c.cycles = o.integer("cycles", std::nullopt, 1, 100000);
+    c.start = o.non_negative("start", 0.0);
+    if (c.cycles > 0 && c.start + c.cycles * c.period > s.t_end * (1 + 1e-9))
+      fail(o.path("cycles"), std::to_string(c.cycles) +
+                                 " cycles need time.end >= " + json(c.start + c.cycles * c.period).dump() +
+                                 " s, got " + json(s.t_end).dump());
+    if (c.period < 4.0 * s.output_interval)
+      fail(o.path("period"),
+           "must hold at least 4 outputs (time.output_interval " + json(s.output_interval).dump() + " s)");
+    if (c.start + c.period > s.t_end + 1e-9 * c.period)
+      fail(o.path("period"), "time.end " + json(s.t_end).dump() + " s holds no complete cycle (start " +
+                                 json(c.start).dump() + " s + period)");
+    auto column = [&](const char* key, bool required, std::string& out) {
+      if (!required && !o.has(key)) return;
+      out = o.string(key);
+      const Probe* p = column_probe(s, out);
+      if (!p) fail(o.path(key), "no probe writes a column '" + out + "'");
+    };
+    column("valve_flow", true, c.valve_flow);
+    column("lv_pressure", true, c.lv_pressure);
+    column("aortic_pressure", true, c.aortic_pressure);
+    column("orifice_area", false, c.orifice_area);
+    column("jet_speed", false, c.jet_speed);
+    column("lvot_flow", false, c.lvot_flow);
+    if (o.has("lvot_area")) {
+      c.lvot_area = o.positive("lvot_area");
+    } else {
+      // The disc of the flow_rate probe the LVOT flow is read from: pi r^2.
+      const Probe* p = column_probe(s, c.lvot_flow.empty() ? c.valve_flow : c.lvot_flow);
+      if (p && p->type == ProbeType::FlowRate) c.lvot_area = std::numbers::pi * p->radius * p->radius;
+    }
+    auto named_probe = [&](const char* key, ProbeType type, const char* what, std::string& out) {
+      if (!o.has(key)) return;
+      out = o.string(key);
+      const auto it =
+          std::find_if(s.probes.begin(), s.probes.end(), [&](const Probe& p) { return p.name == out; });
+      if (it == s.probes.end()) fail(o.path(key), "no probe named '" + out + "'");
+      if (it->type != type) fail(o.path(key), "probe '" + out + "' is not a " + what + " probe");
+    };
+    named_probe("stress", ProbeType::Stress, "stress", c.stress);
+    named_probe("coaptation", ProbeType::Coaptation, "coaptation", c.coaptation);
+    c.hold_level = o.non_negative("hold_level", 9332.57);
+    for (const Material& m : s.materials)
+      if (m.type == MaterialType::Fluid) {
+        c.density = m.density;
+        break;
+      }
+    return c;
   }
 
   // [low, high] with low < high (a colour range).

@@ -148,7 +148,9 @@ enum class ProbeType {
   OrificeArea,
   OpenBoundary,
   Stress,
-  Gap
+  Gap,
+  MaxSpeed,    // largest fluid speed in a region (the jet through a valve)
+  Coaptation,  // leaflet coaptation heights and lengths, effective height (docs/valve-metrics.md)
 };
 
 struct Probe {
@@ -163,6 +165,8 @@ struct Probe {
   Vec3 normal = Vec3::UnitY();    // flow_rate, orifice_area
   Vec3 reference = Vec3::Zero();  // point
   double radius = 0.0;            // flow_rate, orifice_area
+  double distance = 0.0;          // coaptation: contact distance [m]
+  double central_radius = 0.0;    // coaptation: radius about the axis counted as the centre [m]
 };
 
 // A value that may vary in time: one constant, or a table of (t, value) pairs with strictly increasing times,
@@ -258,6 +262,20 @@ struct RenderSettings {
   }
 };
 
+// The cardiac cycle of a run (docs/scenes.md "cycle", docs/valve-metrics.md): the period, and the probe
+// columns the per-cycle valve metrics read (empty: not measured).
+struct CycleSpec {
+  double period = 0.8;  // [s]
+  int cycles = 0;       // 0: as many as time.end holds
+  double start = 0.0;   // cycle k is [start + k period, start + (k+1) period)
+  std::string lv_pressure, aortic_pressure, valve_flow, orifice_area, jet_speed, lvot_flow;  // columns
+  double lvot_area = 0.0;       // [m^2]; 0: from the lvot_flow (or valve_flow) probe's disc
+  std::string stress;           // a stress probe's name
+  std::string coaptation;       // a coaptation probe's name
+  double hold_level = 9332.57;  // [Pa] diastolic pressure difference counted as held (70 mmHg)
+  double density = 1060.0;      // [kg/m^3] fluid density for the Gorlin EOA
+};
+
 struct Scene {
   std::string name;
   Box domain;
@@ -279,6 +297,7 @@ struct Scene {
   std::vector<Body> bodies;
   std::vector<OpenBoundarySpec> open_boundaries;
   std::vector<Probe> probes;
+  std::optional<CycleSpec> cycle;
   RenderSettings render;
 };
 

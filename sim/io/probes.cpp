@@ -1,5 +1,7 @@
 #include "io/probes.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -71,12 +73,110 @@ GapStats body_gap(const World& world, const std::vector<int>& bodies) {
   return g;
 }
 
+// Largest eigenvalue of the Green-Lagrange strain E = (F^T F - I) / 2 (paper eq. 15).
+double largest_principal_strain(const Eigen::Matrix3d& F) {
+  const Eigen::Matrix3d E = 0.5 * (F.transpose() * F - Eigen::Matrix3d::Identity());
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(E, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+}
+
+struct CoaptationStats {
+  std::vector<double> height, length;  // per leaflet pair (a < b in list order)
+  double central_height = 0.0, effective_height = 0.0;
+};
+
+// Coaptation of the listed leaflets (docs/valve-metrics.md): particles of two leaflets closer than the
+// contact distance are in contact. Per pair, the coaptation height is the extent along the valve axis of its
+// contact particles and the coaptation length their radial extent; the central coaptation height is the
+// axial extent of the contact particles within central_radius of the axis; the effective height is the axial
+// distance from the annulus plane (the probe's point and normal) to the highest leaflet particle within
+// central_radius of the axis (NaN when none is there: an open valve). Extents are max - min: independent of
+// the visiting order.
+CoaptationStats coaptation(const World& world, const Probe& pr) {
+  const Particles& P = world.particles();
+  const std::size_t nb_bodies = pr.bodies.size();
+  std::vector<int> slot(world.bodies().size(), -1);
+  for (std::size_t k = 0; k < nb_bodies; ++k) slot[pr.bodies[k]] = static_cast<int>(k);
+  const Vec3 axis = pr.normal.normalized();
+  std::vector<Vec3> x;
+  std::vector<int> leaf;
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (slot[P.body[i]] >= 0) {
+      x.push_back(P.x[i]);
+      leaf.push_back(slot[P.body[i]]);
+    }
+  std::vector<double> z(x.size()), r(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const Vec3 rel = x[i] - pr.point;
+    z[i] = rel.dot(axis);
+    r[i] = (rel - z[i] * axis).norm();
+  }
+  auto pair_index = [&](int a, int b) {
+    if (a > b) std::swap(a, b);
+    return static_cast<std::size_t>(a * static_cast<int>(nb_bodies) - a * (a + 1) / 2 + (b - a - 1));
+  };
+  const std::size_t pairs = nb_bodies * (nb_bodies - 1) / 2;
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> zmin(pairs, inf), zmax(pairs, -inf), rmin(pairs, inf), rmax(pairs, -inf);
+  double czmin = inf, czmax = -inf, top = -inf;
+  NeighborSearch nb;
+  nb.build(x, pr.distance);
+  auto mark = [&](std::size_t p, std::size_t i) {
+    zmin[p] = std::min(zmin[p], z[i]);
+    zmax[p] = std::max(zmax[p], z[i]);
+    rmin[p] = std::min(rmin[p], r[i]);
+    rmax[p] = std::max(rmax[p], r[i]);
+    if (r[i] < pr.central_radius) {
+      czmin = std::min(czmin, z[i]);
+      czmax = std::max(czmax, z[i]);
+    }
+  };
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (r[i] < pr.central_radius) top = std::max(top, z[i]);
+    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
+      const uint32_t j = nb.index()[k];
+      if (j <= i || leaf[j] == leaf[i]) continue;
+      const std::size_t p = pair_index(leaf[i], leaf[j]);
+      mark(p, i);
+      mark(p, j);
+    }
+  }
+  CoaptationStats c;
+  for (std::size_t p = 0; p < pairs; ++p) {
+    c.height.push_back(zmax[p] >= zmin[p] ? zmax[p] - zmin[p] : 0.0);
+    c.length.push_back(rmax[p] >= rmin[p] ? rmax[p] - rmin[p] : 0.0);
+  }
+  c.central_height = czmax >= czmin ? czmax - czmin : 0.0;
+  c.effective_height = std::isfinite(top) ? top : kNaN;
+  return c;
+}
+
 void add_columns(std::vector<std::string>& cols, const std::string& name,
                  std::initializer_list<const char*> fields) {
   for (const char* f : fields) cols.push_back(name + "." + f);
 }
 
 }  // namespace
+
+double percentile_nearest_rank(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const std::size_t rank = static_cast<std::size_t>(std::ceil(q / 100.0 * static_cast<double>(v.size())));
+  const std::size_t k = std::min(v.size() - 1, rank > 0 ? rank - 1 : 0);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+std::vector<std::string> coaptation_columns(std::size_t leaflets) {
+  std::vector<std::string> cols;
+  for (std::size_t a = 0; a < leaflets; ++a)
+    for (std::size_t b = a + 1; b < leaflets; ++b) {
+      const std::string pair = std::to_string(a) + "_" + std::to_string(b);
+      cols.push_back("height_" + pair);
+      cols.push_back("length_" + pair);
+    }
+  cols.push_back("central_height");
+  cols.push_back("effective_height");
+  return cols;
+}
 
 ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probes) {
   const Particles& P = world.particles();
@@ -127,10 +227,17 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
         columns_.push_back(pr.name);
         break;
       case ProbeType::Stress:
-        add_columns(columns_, pr.name, {"max", "mean"});
+        add_columns(columns_, pr.name, {"max", "mean", "p95", "strain_max"});
         break;
       case ProbeType::Gap:
         add_columns(columns_, pr.name, {"min", "overlaps"});
+        break;
+      case ProbeType::MaxSpeed:
+        columns_.push_back(pr.name);
+        break;
+      case ProbeType::Coaptation:
+        for (const std::string& c : coaptation_columns(pr.bodies.size()))
+          columns_.push_back(pr.name + "." + c);
         break;
     }
   }
@@ -331,7 +438,39 @@ std::vector<double> ProbeSet::measure(const World& world) const {
             [](const MS& a, const MS& b) {
               return MS{std::max(a.max, b.max), a.sum + b.sum, a.count + b.count};
             });
-        out.insert(out.end(), {r.max, r.count > 0 ? r.sum / r.count : 0.0});
+        // The 95th percentile (nearest rank) of the gathered values and the largest principal Green-Lagrange
+        // strain (eq. 15): gathered in array order, so the same for any thread count.
+        std::vector<double> vm;
+        double strain = 0.0;
+        for (std::size_t s = 0; s < S.size(); ++s)
+          if (in_set[P.body[S.at(s)]]) {
+            vm.push_back(S.von_mises(s));
+            strain = std::max(strain, largest_principal_strain(S.F(s)));
+          }
+        out.insert(out.end(),
+                   {r.max, r.count > 0 ? r.sum / r.count : 0.0, percentile_nearest_rank(vm, 95.0), strain});
+        break;
+      }
+      case ProbeType::MaxSpeed: {
+        // Largest speed of a fluid particle (buffers excluded) of the listed bodies (all fluid when none)
+        // inside the region (everywhere when none).
+        const std::vector<char> in_set = body_mask(world, pr.bodies);
+        const double best = parallel_reduce(
+            n, -1.0,
+            [&](std::size_t i) {
+              if (P.kind[i] != Kind::Fluid || (!pr.bodies.empty() && !in_set[P.body[i]]) ||
+                  (pr.region && !pr.region->contains(P.x[i])))
+                return -1.0;
+              return P.v[i].norm();
+            },
+            [](double a, double b) { return std::max(a, b); });
+        out.push_back(best >= 0.0 ? best : kNaN);
+        break;
+      }
+      case ProbeType::Coaptation: {
+        const CoaptationStats c = coaptation(world, pr);
+        for (std::size_t k = 0; k < c.height.size(); ++k) out.insert(out.end(), {c.height[k], c.length[k]});
+        out.insert(out.end(), {c.central_height, c.effective_height});
         break;
       }
       case ProbeType::Gap: {

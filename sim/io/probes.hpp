@@ -8,6 +8,13 @@
 
 namespace aortasph {
 
+// The nearest-rank q-th percentile of v (the ceil(q/100 n)-th smallest value; 0 for no value).
+double percentile_nearest_rank(std::vector<double> v, double q);
+
+// The columns of a coaptation probe over `leaflets` bodies, without the probe's name: height_A_B and
+// length_A_B per pair A < B of list positions, then central_height and effective_height.
+std::vector<std::string> coaptation_columns(std::size_t leaflets);
+
 class ProbeSet {
  public:
   // Resolves what needs the initial state (the particle a `point` probe follows). Throws SetupError for a

@@ -1,0 +1,370 @@
+#include "cycle_report.hpp"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "embedded_scripts.hpp"
+#include "errors.hpp"
+#include "io/probes.hpp"
+#include "output.hpp"
+#include "scene_loader.hpp"
+
+extern char** environ;
+
+namespace aortasph {
+
+namespace fs = std::filesystem;
+
+int CsvTable::column(const std::string& name) const {
+  const auto it = std::find(header.begin(), header.end(), name);
+  return it == header.end() ? -1 : static_cast<int>(it - header.begin());
+}
+
+CsvTable read_csv(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string() + ": cannot read");
+  CsvTable t;
+  std::string line;
+  if (!std::getline(in, line) || line.empty()) throw InputError(file.string() + ":1: no header");
+  {
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) t.header.push_back(cell);
+  }
+  long number = 1;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty()) continue;
+    std::vector<double> row;
+    std::size_t from = 0;
+    while (true) {
+      const std::size_t to = line.find(',', from);
+      const std::string cell = line.substr(from, to == std::string::npos ? std::string::npos : to - from);
+      if (cell.empty()) {
+        row.push_back(std::nan(""));
+      } else {
+        char* end = nullptr;
+        const double v = std::strtod(cell.c_str(), &end);
+        if (end == cell.c_str() || *end != '\0')
+          throw InputError(file.string() + ":" + std::to_string(number) + ": not a number: '" + cell + "'");
+        row.push_back(v);
+      }
+      if (to == std::string::npos) break;
+      from = to + 1;
+    }
+    if (row.size() != t.header.size())
+      throw InputError(file.string() + ":" + std::to_string(number) + ": " + std::to_string(row.size()) +
+                       " cells, the header has " + std::to_string(t.header.size()));
+    t.rows.push_back(std::move(row));
+  }
+  return t;
+}
+
+namespace {
+
+const Probe* probe_named(const Scene& s, const std::string& name) {
+  for (const Probe& p : s.probes)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+// The columns of the stress and coaptation probes the block names ("cycle.stress" and so on as the path).
+std::vector<std::pair<std::string, std::string>> probe_columns_of_block(const Scene& s) {
+  std::vector<std::pair<std::string, std::string>> out;
+  const CycleSpec& c = *s.cycle;
+  if (!c.stress.empty())
+    for (const char* f : {"max", "mean", "p95", "strain_max"})
+      out.emplace_back("cycle.stress", c.stress + "." + f);
+  if (!c.coaptation.empty())
+    if (const Probe* p = probe_named(s, c.coaptation))
+      for (const std::string& f : coaptation_columns(p->bodies.size()))
+        out.emplace_back("cycle.coaptation", c.coaptation + "." + f);
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> cycle_columns(const Scene& s) {
+  std::vector<std::pair<std::string, std::string>> out;
+  if (!s.cycle) return out;
+  const CycleSpec& c = *s.cycle;
+  const std::pair<const char*, const std::string*> named[] = {{"cycle.valve_flow", &c.valve_flow},
+                                                              {"cycle.lv_pressure", &c.lv_pressure},
+                                                              {"cycle.aortic_pressure", &c.aortic_pressure},
+                                                              {"cycle.orifice_area", &c.orifice_area},
+                                                              {"cycle.jet_speed", &c.jet_speed},
+                                                              {"cycle.lvot_flow", &c.lvot_flow}};
+  for (const auto& [path, col] : named)
+    if (!col->empty()) out.emplace_back(path, *col);
+  return out;
+}
+
+void check_cycle_columns(const Scene& s, const std::vector<std::string>& columns) {
+  if (!s.cycle) return;
+  auto all = cycle_columns(s);
+  const auto more = probe_columns_of_block(s);
+  all.insert(all.end(), more.begin(), more.end());
+  for (const auto& [path, col] : all) {
+    if (std::find(columns.begin(), columns.end(), col) != columns.end()) continue;
+    // Name the columns of the probe the name starts with, to show what was meant.
+    std::string near;
+    for (const std::string& c : columns)
+      if (c.compare(0, col.find('.'), col.substr(0, col.find('.'))) == 0)
+        near += (near.empty() ? "" : ", ") + c;
+    throw InputError(path + ": no probe writes a column '" + col + "'" +
+                     (near.empty() ? std::string() : " (similar columns: " + near + ")"));
+  }
+}
+
+std::vector<CycleMetrics> cycle_metrics_of(const Scene& s, const CsvTable& table) {
+  if (!s.cycle) return {};
+  const CycleSpec& c = *s.cycle;
+  const int tcol = table.column("time");
+  if (tcol < 0) throw InputError("probes.csv: no time column");
+  CycleSignals sig;
+  auto col = [&](const std::string& name) {
+    std::vector<double> v;
+    const int k = name.empty() ? -1 : table.column(name);
+    if (k < 0) return v;
+    for (const auto& r : table.rows) v.push_back(r[k]);
+    return v;
+  };
+  // Strictly increasing times only (a resumed run's file is; this guards a hand-edited one).
+  sig.t = col("time");
+  for (std::size_t i = 1; i < sig.t.size(); ++i)
+    if (!(sig.t[i] > sig.t[i - 1]))
+      throw InputError("probes.csv: times are not increasing at row " + std::to_string(i + 1));
+  sig.valve_flow = col(c.valve_flow);
+  sig.lv_pressure = col(c.lv_pressure);
+  sig.aortic_pressure = col(c.aortic_pressure);
+  sig.orifice_area = col(c.orifice_area);
+  sig.jet_speed = col(c.jet_speed);
+  sig.lvot_flow = col(c.lvot_flow);
+  if (!c.stress.empty()) {
+    sig.stress_max = col(c.stress + ".max");
+    sig.stress_mean = col(c.stress + ".mean");
+    sig.stress_p95 = col(c.stress + ".p95");
+    sig.strain_max = col(c.stress + ".strain_max");
+  }
+  if (!c.coaptation.empty())
+    if (const Probe* p = probe_named(s, c.coaptation)) {
+      const std::size_t n = p->bodies.size();
+      for (std::size_t a = 0; a < n; ++a)
+        for (std::size_t b = a + 1; b < n; ++b) {
+          const std::string pair = std::to_string(a) + "_" + std::to_string(b);
+          sig.pair_names.push_back(pair);
+          sig.coaptation_height.push_back(col(c.coaptation + ".height_" + pair));
+          sig.coaptation_length.push_back(col(c.coaptation + ".length_" + pair));
+        }
+      sig.central_height = col(c.coaptation + ".central_height");
+      sig.effective_height = col(c.coaptation + ".effective_height");
+    }
+  CycleOptions o;
+  o.period = c.period;
+  o.start = c.start;
+  o.lvot_area = c.lvot_area;
+  o.density = c.density;
+  o.hold_level = c.hold_level;
+  std::vector<CycleMetrics> out = all_cycle_metrics(sig, o);
+  if (c.cycles > 0 && static_cast<int>(out.size()) > c.cycles) out.resize(c.cycles);
+  return out;
+}
+
+void write_cycles_csv(const fs::path& file, const std::vector<CycleMetrics>& cycles) {
+  std::ofstream f(file, std::ios::trunc);
+  if (!f) throw InputError(file.string() + ": cannot open for writing");
+  const auto header = metric_table(cycles.empty() ? CycleMetrics{} : cycles.front());
+  for (std::size_t k = 0; k < header.size(); ++k) f << (k ? "," : "") << header[k].first;
+  f << '\n';
+  for (const CycleMetrics& m : cycles) {
+    const auto row = metric_table(m);
+    for (std::size_t k = 0; k < row.size(); ++k)
+      f << (k ? "," : "") << (std::isnan(row[k].second) ? std::string() : format_number(row[k].second));
+    f << '\n';
+  }
+  f.close();
+  if (!f) throw InputError(file.string() + ": write failed (disk full?)");
+}
+
+nlohmann::json cycles_json(const Scene& s, const std::vector<CycleMetrics>& cycles) {
+  nlohmann::json j;
+  j["period_s"] = s.cycle->period;
+  j["start_s"] = s.cycle->start;
+  j["complete"] = cycles.size();
+  if (s.cycle->cycles > 0) j["requested"] = s.cycle->cycles;
+  j["file"] = "cycles.csv";
+  j["per_cycle"] = nlohmann::json::array();
+  for (const CycleMetrics& m : cycles) {
+    nlohmann::json row;
+    for (const auto& [name, v] : metric_table(m))
+      row[name] = std::isnan(v) ? nlohmann::json() : nlohmann::json(v);
+    row["periodic"] = m.cycle == 0 ? nlohmann::json() : nlohmann::json(m.periodic);
+    j["per_cycle"].push_back(row);
+  }
+  if (!cycles.empty()) {
+    j["metrics_from_cycle"] = cycles.back().cycle;
+    j["metrics"] = j["per_cycle"].back();
+    j["periodic_state"] = cycles.size() > 1 ? nlohmann::json(cycles.back().periodic) : nlohmann::json();
+  }
+  j["periodic_tolerance_pct"] = 2.0;
+  return j;
+}
+
+std::string cycle_line(const CycleMetrics& m) {
+  char buf[512];
+  auto f = [](double v) {
+    if (std::isnan(v)) return std::string("--");
+    char b[32];
+    std::snprintf(b, sizeof b, "%.4g", v);
+    return std::string(b);
+  };
+  std::snprintf(buf, sizeof buf,
+                "cycle %d [%g, %g] s: SV %s ml, peak flow %s ml/s, mean gradient %s mmHg, peak GOA %s cm2, "
+                "end-diastolic aortic %s mmHg; ",
+                m.cycle, m.t_start, m.t_end, f(m.stroke_volume_ml).c_str(),
+                f(m.peak_forward_flow_ml_s).c_str(), f(m.mean_gradient_mmHg).c_str(),
+                f(m.peak_goa_cm2).c_str(), f(m.aortic_end_diastolic_mmHg).c_str());
+  std::string s = buf;
+  if (m.cycle == 0) {
+    s += "periodic state: -- (first cycle)";
+  } else {
+    std::snprintf(buf, sizeof buf, "SV change %s %%, EDP change %s %%: %s", f(m.sv_change_pct).c_str(),
+                  f(m.edp_change_pct).c_str(), m.periodic ? "periodic (both < 2 %)" : "not periodic yet");
+    s += buf;
+  }
+  return s;
+}
+
+namespace {
+
+// Runs a program without a shell; quiet: its stdout and stderr go to /dev/null. Returns its exit status.
+int spawn(const std::vector<std::string>& argv, bool quiet) {
+  std::vector<char*> cargs;
+  for (const auto& a : argv) cargs.push_back(const_cast<char*>(a.c_str()));
+  cargs.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  if (quiet) {
+    posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
+  }
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, cargs[0], &fa, nullptr, cargs.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) return 127;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+// A python3 that imports matplotlib: $AORTASPH_PYTHON, /usr/bin/python3 (Debian's, where python3-matplotlib
+// installs), then python3 on PATH; empty when none does.
+std::string find_python() {
+  std::vector<std::string> candidates;
+  if (const char* env = std::getenv("AORTASPH_PYTHON"); env && *env) {
+    candidates.push_back(env);
+  } else {
+    candidates.push_back("/usr/bin/python3");
+    const char* path = std::getenv("PATH");
+    std::istringstream dirs(path ? path : "");
+    for (std::string dir; std::getline(dirs, dir, ':');)
+      candidates.push_back((fs::path(dir.empty() ? "." : dir) / "python3").string());
+  }
+  for (const std::string& c : candidates)
+    if (access(c.c_str(), X_OK) == 0 && spawn({c, "-c", "import matplotlib"}, true) == 0) return c;
+  return "";
+}
+
+}  // namespace
+
+int make_wiggers_plot(const fs::path& dir, std::string& error) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
+    error = dir.string() + ": no such folder";
+    return 2;
+  }
+  const fs::path run_json = dir / "run.json", probes = dir / "probes.csv", cycles = dir / "cycles.csv";
+  auto missing = [&](const fs::path& f) {
+    error = f.string() + ": missing (not the folder of a finished run?)";
+    return 2;
+  };
+  if (!fs::is_regular_file(run_json, ec)) return missing(run_json);
+  Scene scene;
+  try {
+    std::ifstream in(run_json);
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.is_object() || !j.contains("scene") || !j["scene"].is_object()) {
+      error = run_json.string() + ": not a run.json (no scene)";
+      return 2;
+    }
+    // The render block is not needed here (and a run with --end-time may hold figure times past its end).
+    nlohmann::json recorded = j["scene"];
+    recorded.erase("render");
+    scene = load_scene_json(recorded, {}).scene;
+  } catch (const InputError& e) {
+    error = run_json.string() + ": its scene: " + e.what();
+    return 2;
+  }
+  if (!scene.cycle) {
+    error = run_json.string() + ": the run's scene has no cycle block (docs/scenes.md \"cycle\")";
+    return 2;
+  }
+  if (!fs::is_regular_file(probes, ec)) return missing(probes);
+  if (!fs::is_regular_file(cycles, ec)) return missing(cycles);
+  try {
+    const CsvTable table = read_csv(probes);
+    const std::vector<std::string> columns(table.header.begin() + 1, table.header.end());
+    check_cycle_columns(scene, columns);
+    if (table.rows.size() < 2) {
+      error = probes.string() + ": fewer than two rows";
+      return 2;
+    }
+    read_csv(cycles);
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    error = what.rfind("cycle.", 0) == 0 ? probes.string() + ": " + what : what;
+    return 2;
+  }
+  const std::string python = find_python();
+  if (python.empty()) {
+    error =
+        "no python3 with matplotlib found (install it: apt-get install python3-matplotlib; or set "
+        "AORTASPH_PYTHON)";
+    return 2;
+  }
+  fs::create_directories(dir / "figures", ec);
+  const fs::path png = dir / "figures" / "wiggers.png";
+  const int rc =
+      spawn({python, "-c", std::string(scripts::plot_wiggers_py), dir.string(), png.string()}, false);
+  if (rc != 0 || !fs::is_regular_file(png, ec)) {
+    error = "scripts/plot_wiggers.py failed (exit " + std::to_string(rc) + ")";
+    return 2;
+  }
+  return 0;
+}
+
+int cmd_plot(const std::vector<std::string>& args) {
+  if (args.size() != 1 || args[0].empty() || args[0][0] == '-') {
+    std::fprintf(stderr, "aortasph plot: error: expected one output folder\nusage: aortasph plot OUT_DIR\n");
+    return 2;
+  }
+  std::string error;
+  const int rc = make_wiggers_plot(args[0], error);
+  if (rc != 0) {
+    std::fprintf(stderr, "aortasph plot: error: %s\n", error.c_str());
+    return rc;
+  }
+  std::printf("%s\n", (fs::path(args[0]) / "figures" / "wiggers.png").string().c_str());
+  return 0;
+}
+
+}  // namespace aortasph
