@@ -540,7 +540,8 @@ int cmd_resume(const ResumeOptions& ro) {
   // Loaded as the file was (figure times are checked against the file's time.end), then --end-time again.
   nlohmann::json as_file = resolved;
   if (record.end_override > 0.0) as_file["time"]["end"] = record.file_end;
-  LoadedScene loaded = load_scene_json(as_file, {});
+  // Files the scene names (waveforms) are relative to the scene file's folder, as when it was run.
+  LoadedScene loaded = load_scene_json(as_file, {}, std::filesystem::path(record.scene_file).parent_path());
   if (record.end_override > 0.0) {
     loaded.scene.t_end = record.end_override;
     loaded.resolved["time"]["end"] = record.end_override;
