@@ -720,3 +720,24 @@ TEST_CASE(
   CHECK(probes == aortasph::test::slurp(whole / "probes.csv"));
   fs::remove_all(dir);
 }
+
+TEST_CASE("scenes/aortic_valve_cycle_physio.json loads: the LV waveform inlet and the systemic RCR outlet",
+          "[physiology][scene]") {
+  const fs::path file = fs::path(AORTASPH_TEST_DIR) / ".." / "scenes" / "aortic_valve_cycle_physio.json";
+  const Scene s = load_scene(file, {}).scene;
+  REQUIRE(s.open_boundaries.size() == 2);
+  const OpenBoundarySpec& lv = s.open_boundaries[0];
+  const OpenBoundarySpec& ao = s.open_boundaries[1];
+  REQUIRE(lv.pressure_inlet);
+  REQUIRE(ao.windkessel);
+  CHECK(lv.inlet_pressure.period == 0.8);
+  // 0 mmHg is the fluid's background pressure (2000 Pa); the LV waveform starts at end diastole, 8 mmHg.
+  CHECK((lv.inlet_pressure.at(0.0) - 2000.0) / kMmHg == Approx(8.076).epsilon(1e-3));
+  CHECK(ao.windkessel->proximal_resistance * kMl / kMmHg == Approx(0.05).epsilon(1e-3));
+  CHECK(ao.windkessel->capacitance * kMmHg / kMl == Approx(1.6).epsilon(1e-3));
+  CHECK(ao.windkessel->distal_resistance * kMl / kMmHg == Approx(1.05).epsilon(1e-3));
+  CHECK((ao.windkessel->initial_pressure - 2000.0) / kMmHg == Approx(80.0).epsilon(1e-3));
+  // The sound speed carries a 16 kPa swing with a density change below 1 %.
+  const Material& blood = s.materials[s.bodies[lv.body].material];
+  CHECK(16e3 / (blood.density * blood.sound_speed * blood.sound_speed) < 0.01);
+}
