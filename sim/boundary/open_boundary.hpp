@@ -25,8 +25,8 @@
 //     when it passes the buffer's far face. If it returns across the disc (backflow) it turns back into
 //     fluid and a new outflow particle is created `layers` spacings further out, so the buffer stays full
 //     through back-and-forth flow.
-//   - Fluid particles that flow backwards more than one spacing into an inflow buffer are removed (counted as
-//     volume out).
+//   - Fluid particles that flow backwards more than one spacing into a velocity inlet's buffer are removed
+//     (counted as volume out).
 //   - Pressure inlet (an inflow given `pressure` instead of `velocity`, issue 17): pressure Dirichlet,
 //     velocity Neumann, the outflow's treatment mirrored across the disc. The buffer is laid on the lattice
 //     as a velocity inlet's; its particles take the prescribed p(t) plus the hydrostatic difference (density
