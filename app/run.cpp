@@ -586,7 +586,8 @@ int cmd_resume(const ResumeOptions& ro) {
   // Loaded as the file was (figure times are checked against the file's time.end), then --end-time again.
   nlohmann::json as_file = resolved;
   if (record.end_override > 0.0) as_file["time"]["end"] = record.file_end;
-  LoadedScene loaded = load_scene_json(as_file, {});
+  // Files the scene names (waveforms) are relative to the scene file's folder, as when it was run.
+  LoadedScene loaded = load_scene_json(as_file, {}, std::filesystem::path(record.scene_file).parent_path());
   if (record.end_override > 0.0) {
     loaded.scene.t_end = record.end_override;
     loaded.resolved["time"]["end"] = record.end_override;
@@ -635,7 +636,16 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
     std::printf("  total %zu particles (%zu fluid, %zu inflow buffer, %zu outflow buffer, %zu boundary)\n", n,
                 nf, nin, nout, n - nf - nin - nout);
   for (const OpenBoundarySpec& o : scene.open_boundaries) {
-    if (o.type == OpenBoundaryType::Inflow)
+    if (o.type == OpenBoundaryType::Inflow && o.pressure_inlet)
+      std::printf("  inflow  %-12s radius %g m, %d layers, pressure inlet, pressure %g Pa at t = 0\n",
+                  o.name.c_str(), o.radius, o.layers, o.inlet_pressure.at(0.0));
+    else if (o.type == OpenBoundaryType::Outflow && o.windkessel)
+      std::printf(
+          "  outflow %-12s radius %g m, %d layers, RCR Windkessel (R_p %g, C %g, R_d %g, P_d %g), "
+          "P_c %g Pa at t = 0\n",
+          o.name.c_str(), o.radius, o.layers, o.windkessel->proximal_resistance, o.windkessel->capacitance,
+          o.windkessel->distal_resistance, o.windkessel->distal_pressure, o.windkessel->initial_pressure);
+    else if (o.type == OpenBoundaryType::Inflow)
       std::printf("  inflow  %-12s radius %g m, %d layers, %s profile, velocity %g m/s at t = 0\n",
                   o.name.c_str(), o.radius, o.layers, o.parabolic ? "parabolic" : "uniform",
                   o.velocity.at(0.0));

@@ -10,6 +10,7 @@
 
 #include "errors.hpp"
 #include "geometry/aortic_root.hpp"
+#include "waveform_csv.hpp"
 
 namespace aortasph {
 
@@ -173,6 +174,7 @@ class Obj {
 class Loader {
  public:
   std::map<std::string, std::set<std::string>> allowed;
+  std::filesystem::path base_dir;  // the scene file's folder: files the scene names are relative to it
 
   Scene load(json& root) {
     Scene s;
@@ -620,12 +622,22 @@ class Loader {
     if (j.contains("type") && type != "inflow" && type != "outflow")
       fail(path + ".type", "unknown value " + j["type"].dump() + " (expected one of: inflow, outflow)");
     std::vector<std::string> keys = {"name", "type", "point", "normal", "radius", "layers"};
-    if (type == "inflow") keys.insert(keys.end(), {"body", "velocity", "profile"});
-    if (type == "outflow") keys.insert(keys.end(), {"pressure"});
+    if (type == "inflow") keys.insert(keys.end(), {"body", "velocity", "profile", "pressure"});
+    if (type == "outflow") keys.insert(keys.end(), {"pressure", "windkessel"});
+    // An inflow is driven by a velocity or by a pressure, an outflow holds a pressure or a Windkessel: one
+    // of the two (issue 17).
+    if (type == "inflow" && j.contains("velocity") && j.contains("pressure"))
+      fail(path + ".pressure", "an inflow takes either 'velocity' or 'pressure', not both");
+    if (type == "inflow" && !j.contains("velocity") && !j.contains("pressure"))
+      fail(path + ".velocity", "missing (an inflow needs 'velocity' or 'pressure')");
+    if (type == "outflow" && j.contains("pressure") && j.contains("windkessel"))
+      fail(path + ".windkessel", "an outflow takes either 'pressure' or 'windkessel', not both");
     Obj o(j, path, keys, allowed);
     OpenBoundarySpec b;
     b.name = o.string("name");
     if (b.name.empty()) fail(o.path("name"), "must not be empty");
+    if (b.name.find_first_of(",\"\n") != std::string::npos)
+      fail(o.path("name"), "must not contain commas or quotes (it names probe columns)");
     b.type = o.choice("type", {"inflow", "outflow"}) == "inflow" ? OpenBoundaryType::Inflow
                                                                  : OpenBoundaryType::Outflow;
     b.point = o.vec3("point");
@@ -644,12 +656,71 @@ class Loader {
       if (s.materials[s.bodies[b.body].material].type != MaterialType::Fluid)
         fail(o.path("body"),
              "body '" + s.bodies[b.body].name + "' is not a fluid (an inflow feeds a fluid body)");
-      b.velocity = series(o, "velocity", std::nullopt, true);
-      b.parabolic = o.choice("profile", {"uniform", "parabolic"}, "uniform") == "parabolic";
+      if (o.has("pressure")) {
+        if (o.has("profile"))
+          fail(o.path("profile"),
+               "a pressure inlet has no prescribed profile (its velocity comes from the fluid)");
+        b.pressure_inlet = true;
+        b.inlet_pressure = waveform(o, "pressure");
+      } else {
+        b.velocity = series(o, "velocity", std::nullopt, true);
+        b.parabolic = o.choice("profile", {"uniform", "parabolic"}, "uniform") == "parabolic";
+      }
+    } else if (o.has("windkessel")) {
+      b.windkessel = windkessel(o.raw("windkessel"), o.path("windkessel"));
     } else {
       b.pressure = series(o, "pressure", 0.0, false);
     }
     return b;
+  }
+
+  // An inflow's pressure (issue 17): a number, a table [[t, p], ...] (as series()), or a waveform file
+  // {"file", "units", "period", "offset"}.
+  Waveform waveform(Obj& o, const std::string& key) {
+    json& v = o.raw(key);
+    if (!v.is_object()) {
+      const TimeSeries ts = series(o, key, std::nullopt, false);
+      Waveform w;
+      w.t = ts.t;
+      w.value = ts.value;
+      return w;
+    }
+    Obj f(v, o.path(key), {"file", "units", "period", "offset"}, allowed);
+    const std::string units = f.choice("units", {"Pa", "mmHg"});
+    const double scale = units == "mmHg" ? 133.322387415 : 1.0;  // 1 mmHg = 133.322387415 Pa (ISO 80000-4)
+    const std::string name = f.string("file");
+    if (name.empty()) fail(f.path("file"), "must not be empty");
+    const std::filesystem::path file =
+        std::filesystem::path(name).is_absolute() ? std::filesystem::path(name) : base_dir / name;
+    Waveform w;
+    try {
+      w = read_waveform_csv(file, file.string(), scale);
+    } catch (const InputError& e) {
+      fail(f.path("file"), e.what());
+    }
+    if (f.has("period")) {
+      w.period = f.positive("period");
+      if (w.t.back() - w.t.front() > w.period * (1.0 + 1e-12))
+        fail(f.path("period"), "the waveform in " + file.string() + " spans " +
+                                   json(w.t.back() - w.t.front()).dump() + " s, more than one period (" +
+                                   json(w.period).dump() + " s)");
+    }
+    w.offset = f.number("offset", 0.0);
+    return w;
+  }
+
+  // An outflow's RCR Windkessel (sim/physiology/windkessel.hpp), SI units.
+  WindkesselParams windkessel(json& j, const std::string& path) {
+    Obj o(j, path,
+          {"proximal_resistance", "capacitance", "distal_resistance", "distal_pressure", "initial_pressure"},
+          allowed);
+    WindkesselParams w;
+    w.proximal_resistance = o.positive("proximal_resistance");
+    w.capacitance = o.positive("capacitance");
+    w.distal_resistance = o.positive("distal_resistance");
+    w.distal_pressure = o.number("distal_pressure");
+    w.initial_pressure = o.number("initial_pressure");
+    return w;
   }
 
   Probe probe(json& j, const std::string& path, const Scene& s) {
@@ -1013,19 +1084,22 @@ void apply_override(json& root, const std::string& item,
 }  // namespace
 
 LoadedScene load_scene_json(const nlohmann::json& j, const std::vector<std::string>& overrides,
-                            const std::filesystem::path&) {
+                            const std::filesystem::path& base_dir) {
   // First pass: validate the file as written, fill in defaults, learn which optional keys each object allows.
   json filled = j;
   Loader first;
+  first.base_dir = base_dir;
   Scene scene = first.load(filled);
   if (overrides.empty()) return {scene, filled};
   // Then apply --set to the filled JSON and validate again.
   for (const auto& o : overrides) apply_override(filled, o, first.allowed);
-  return {Loader{}.load(filled), filled};
+  Loader second;
+  second.base_dir = base_dir;
+  return {second.load(filled), filled};
 }
 
 LoadedScene load_scene_text(const std::string& text, const std::vector<std::string>& overrides,
-                            const std::string& what) {
+                            const std::string& what, const std::filesystem::path& base_dir) {
   json j;
   try {
     j = json::parse(text);
@@ -1033,7 +1107,7 @@ LoadedScene load_scene_text(const std::string& text, const std::vector<std::stri
     // parse_error, and out_of_range for a number beyond the double range (1e999).
     throw InputError(what + ": not valid JSON: " + e.what());
   }
-  return load_scene_json(j, overrides);
+  return load_scene_json(j, overrides, base_dir);
 }
 
 LoadedScene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
@@ -1044,7 +1118,7 @@ LoadedScene load_scene(const std::filesystem::path& file, const std::vector<std:
   std::ostringstream text;
   text << f.rdbuf();
   if (f.bad()) throw InputError(file.string() + ": cannot read");
-  return load_scene_text(text.str(), overrides, file.string());
+  return load_scene_text(text.str(), overrides, file.string(), file.parent_path());
 }
 
 }  // namespace aortasph

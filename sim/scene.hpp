@@ -11,6 +11,9 @@
 #include <utility>
 #include <vector>
 
+#include "physiology/waveform.hpp"
+#include "physiology/windkessel.hpp"
+
 namespace aortasph {
 
 using Vec3 = Eigen::Vector3d;
@@ -200,6 +203,13 @@ struct OpenBoundarySpec {
   TimeSeries velocity;     // inflow: mean velocity over the inlet [m/s]
   bool parabolic = false;  // inflow: Poiseuille profile instead of uniform
   TimeSeries pressure;     // outflow: pressure at the outlet face [Pa]
+  // Inflow given `pressure` instead of `velocity` (issue 17): pressure Dirichlet, velocity Neumann; the
+  // pressure at the inlet face [Pa], absolute in the fluid's terms.
+  bool pressure_inlet = false;
+  Waveform inlet_pressure;
+  // Outflow given `windkessel` instead of `pressure` (issue 17): the outlet pressure is the RCR model's
+  // (sim/physiology/windkessel.hpp), driven by the flow out.
+  std::optional<WindkesselParams> windkessel;
 };
 
 struct Camera {

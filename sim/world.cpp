@@ -584,6 +584,16 @@ void World::save_state(StateWriter& out) const {
   ob.value(os.created);
   ob.value(os.removed);
 
+  // Per open boundary: flow, averaging interval, imposed pressure, Windkessel state (issue 17). A section of
+  // its own, so that checkpoints written before it still load (their boundaries keep the values of t = 0).
+  SectionWriter& of = out.section("open_boundary_flows", 1);
+  of.value(open_.interval_start());
+  of.value(static_cast<uint64_t>(open_.flows().size()));
+  for (const OpenBoundaryFlow& f : open_.flows())
+    for (double v :
+         {f.flow, f.interval_volume, f.pressure, f.windkessel.pc, f.windkessel.q, f.windkessel.p_out})
+      of.value(v);
+
   // The Verlet lists are rebuilt from the positions of their last build (and the rebuild and sort schedule
   // continues from builds_), so the resumed run sees the very lists the saved one had.
   SectionWriter& nb = out.section("neighbors", 1);
@@ -645,6 +655,18 @@ void World::load_state(const StateReader& in) {
   os.created = ob.value<uint64_t>();
   os.removed = ob.value<uint64_t>();
   ob.done();
+
+  if (in.has("open_boundary_flows")) {
+    SectionReader of = in.section("open_boundary_flows");
+    open_.interval_start() = of.value<double>();
+    const auto nf = of.value<uint64_t>();
+    if (nf != open_.flows().size()) of.mismatch("open boundaries", nf, open_.flows().size());
+    for (OpenBoundaryFlow& f : open_.flows())
+      for (double* v :
+           {&f.flow, &f.interval_volume, &f.pressure, &f.windkessel.pc, &f.windkessel.q, &f.windkessel.p_out})
+        *v = of.value<double>();
+    of.done();
+  }
 
   SectionReader nb = in.section("neighbors");
   lists_valid_ = nb.value<bool>();

@@ -2,6 +2,7 @@
 // bottom and an outflow at the top, no gravity, blood.
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
@@ -134,9 +135,15 @@ std::vector<Row> run(const Scene& s, double t_end, double every, std::size_t* in
   World w(s);
   ProbeSet probes(s, w);
   std::vector<Row> rows;
+  // Columns by name: the open_boundary probe has per-boundary columns after its first seven.
+  auto col = [&](const std::string& name) {
+    const auto& c = probes.columns();
+    return static_cast<std::size_t>(std::find(c.begin(), c.end(), name) - c.begin());
+  };
+  const std::size_t ip_out = col("p_out"), ip_in = col("p_in");
   auto sample = [&] {
     const auto v = probes.measure(w);
-    rows.push_back({w.time(), v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9]});
+    rows.push_back({w.time(), v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[ip_out], v[ip_in]});
   };
   sample();
   for (double t = every; t <= t_end + 1e-12; t += every) {
@@ -427,7 +434,9 @@ TEST_CASE("open boundaries: scene keys load, defaults fill in", "[open][scene]")
   ProbeSet probes(s, w);
   CHECK(probes.columns() == std::vector<std::string>{"q", "bal.volume_in", "bal.volume_out",
                                                      "bal.volume_inside", "bal.prescribed_rate",
-                                                     "bal.mass_in", "bal.mass_out", "bal.mass_inside"});
+                                                     "bal.mass_in", "bal.mass_out", "bal.mass_inside",
+                                                     "bal.inlet.flow", "bal.inlet.pressure",
+                                                     "bal.outlet.flow", "bal.outlet.pressure"});
   CHECK(w.count(Kind::Inflow) == 4 * 52);
   CHECK(w.count(Kind::Outflow) == 4 * 52);  // the fluid column runs through the outlet buffer
   // Probes of a body leave its buffer particles out: the fluid's top is below the outlet disc (y = 16 mm).
@@ -491,7 +500,7 @@ TEST_CASE("open boundaries: bad input is refused with the JSON path", "[open][sc
       {"unknown type", [](json& j) { j["open_boundaries"][0]["type"] = "source"; },
        "open_boundaries[0].type: unknown value \"source\""},
       {"pressure on an inflow", [](json& j) { j["open_boundaries"][0]["pressure"] = 0; },
-       "open_boundaries[0].pressure: unknown key"},
+       "open_boundaries[0].pressure: an inflow takes either 'velocity' or 'pressure', not both"},
       {"unknown profile", [](json& j) { j["open_boundaries"][0]["profile"] = "plug"; },
        "open_boundaries[0].profile: unknown value 'plug'"},
       {"duplicate name", [](json& j) { j["open_boundaries"][1]["name"] = "inlet"; },

@@ -25,9 +25,41 @@ enum Action : uint8_t {
   kOutflowToFluid,  // came back across the outlet disc
   kRemove,          // passed the outflow buffer's far face
   kRemoveBackflow,  // fluid that flowed back into an inflow buffer
+  kFluidToInflow,   // fluid that crossed a pressure inlet's disc backwards
 };
 
 }  // namespace
+
+double OpenBoundaries::prescribed_pressure(std::size_t k, double t) const {
+  const Zone& z = zones_[k];
+  if (z.spec.type == OpenBoundaryType::Inflow) return z.spec.inlet_pressure.at(t);
+  if (z.spec.windkessel) return flows_[k].windkessel.p_out;
+  return z.spec.pressure.at(t);
+}
+
+std::vector<double> OpenBoundaries::measure_flows(const Particles& P) const {
+  // Volume flux of the fluid in a slab one kernel support L deep on the domain's side of each disc, with the
+  // smooth window w(d) = sin^2(pi d / L) (open_boundary.hpp).
+  const std::size_t n = P.size();
+  const double L = support_, pi = 3.14159265358979323846;
+  std::vector<double> q(zones_.size(), 0.0);
+  for (std::size_t k = 0; k < zones_.size(); ++k) {
+    const Zone& z = zones_[k];
+    const double side = z.spec.type == OpenBoundaryType::Inflow ? 1.0 : -1.0;
+    const double sum = parallel_reduce(
+        n, 0.0,
+        [&](std::size_t i) {
+          if (P.kind[i] != Kind::Fluid) return 0.0;
+          const double d = side * z.axial(P.x[i]);
+          if (d <= 0.0 || d >= L || z.radial(P.x[i]) >= z.spec.radius) return 0.0;
+          const double w = std::sin(pi * d / L);
+          return P.m[i] / P.rho[i] * P.v[i].dot(z.spec.normal) * w * w;
+        },
+        [](double a, double b) { return a + b; });
+    q[k] = sum / (0.5 * L);
+  }
+  return q;
+}
 
 double OpenBoundaries::Zone::inflow_speed(const Vec3& x, double t) const {
   const double V = spec.velocity.at(t);
@@ -41,6 +73,7 @@ void OpenBoundaries::configure(const Scene& scene, const std::vector<FluidParams
   fluid_ = fluid;
   dx_ = scene.spacing;
   support_ = 2.0 * scene.smoothing_ratio * scene.spacing;
+  output_interval_ = scene.output_interval;
   const double dx = dx_;
   zones_.clear();
   for (std::size_t k = 0; k < scene.open_boundaries.size(); ++k) {
@@ -161,10 +194,19 @@ void OpenBoundaries::setup(const Scene& scene, const std::vector<FluidParams>& f
     if (P.kind[i] == Kind::Fluid && zone_of(P.x[i], Kind::Outflow) >= 0 &&
         zones_[zone_of(P.x[i], Kind::Outflow)].axial(P.x[i]) >= 0.0)
       P.kind[i] = Kind::Outflow;
+  // The flows at t = 0 (the fluid's initial velocity) start the Windkessels.
+  flows_.assign(zones_.size(), OpenBoundaryFlow{});
+  interval_start_ = 0.0;
+  const std::vector<double> q0 = measure_flows(P);
+  for (std::size_t k = 0; k < zones_.size(); ++k) {
+    flows_[k].flow = q0[k];
+    if (zones_[k].spec.windkessel) flows_[k].windkessel = windkessel_start(*zones_[k].spec.windkessel, q0[k]);
+  }
   impose(P, scene.gravity, 0.0);
   for (std::size_t i = first_buffer; i < P.size(); ++i) {
     const Zone& z = zones_[zone_of(P.x[i], Kind::Inflow)];
-    P.v[i] = z.inflow_speed(P.x[i], 0.0) * z.spec.normal;
+    // A pressure inlet's buffer starts at rest; from the first step on it moves with the fluid at the disc.
+    P.v[i] = z.spec.pressure_inlet ? Vec3(Vec3::Zero()) : Vec3(z.inflow_speed(P.x[i], 0.0) * z.spec.normal);
     P.v_wall[i] = P.v[i];
   }
 }
@@ -188,11 +230,12 @@ int OpenBoundaries::zone_of(const Vec3& x, Kind kind) const {
 double OpenBoundaries::prescribed_inflow_rate(double t) const {
   double q = 0.0;
   for (const Zone& z : zones_)
-    if (z.spec.type == OpenBoundaryType::Inflow) q += z.spec.velocity.at(t) * z.area;
+    if (z.spec.type == OpenBoundaryType::Inflow && !z.spec.pressure_inlet)
+      q += z.spec.velocity.at(t) * z.area;
   return q;
 }
 
-void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) const {
+void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) {
   const std::size_t n = P.size();
   const double dx3 = dx_ * dx_ * dx_;
   // Inflow pressure: zero gradient along the axis. The volume-weighted mean pressure of the fluid in a slab
@@ -205,8 +248,9 @@ void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) const {
   std::vector<double> outlet_p(zones_.size(), 0.0);
   for (std::size_t k = 0; k < zones_.size(); ++k) {
     const Zone& z = zones_[k];
-    if (z.spec.type == OpenBoundaryType::Outflow) {
-      outlet_p[k] = z.spec.pressure.at(t);
+    if (z.pressure_driven()) {
+      outlet_p[k] = prescribed_pressure(k, t);
+      flows_[k].pressure = outlet_p[k];
       continue;
     }
     slab[k] = parallel_reduce(
@@ -221,6 +265,7 @@ void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) const {
         [](const Slab& a, const Slab& b) {
           return Slab{a.vol + b.vol, a.pv + b.pv, a.xv + b.xv};
         });
+    flows_[k].pressure = slab[k].vol > 0.0 ? slab[k].pv / slab[k].vol : fluid_.at(z.material).p_background;
   }
   parallel_for(n, [&](std::size_t i) {
     if (P.kind[i] != Kind::Inflow && P.kind[i] != Kind::Outflow) return;
@@ -229,7 +274,7 @@ void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) const {
     const Zone& z = zones_[k];
     const FluidParams& fp = fluid_[P.material[i]];
     double p = 0.0;
-    if (z.spec.type == OpenBoundaryType::Outflow) {
+    if (z.pressure_driven()) {
       p = outlet_p[k] + fp.rho0 * g.dot(P.x[i] - z.spec.point);
     } else if (slab[k].vol > 0.0) {
       p = slab[k].pv / slab[k].vol + fp.rho0 * g.dot(P.x[i] - slab[k].xv / slab[k].vol);
@@ -252,6 +297,17 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
   if (zones_.empty()) return false;
   const std::size_t n = P.size();
 
+  // A step that starts at an output time (a multiple of time.output_interval) starts a new averaging interval
+  // of the boundaries' flows.
+  if (output_interval_ > 0.0) {
+    const double t_old = t_new - dt;
+    const double k = std::round(t_old / output_interval_);
+    if (std::abs(t_old - k * output_interval_) <= 1e-6 * dt && k * output_interval_ > interval_start_) {
+      interval_start_ = k * output_interval_;
+      for (OpenBoundaryFlow& f : flows_) f.interval_volume = 0.0;
+    }
+  }
+
   // Outflow velocity, zero gradient along the axis: in order of increasing distance from the disc, each
   // outflow particle takes the Shepard average of its fluid neighbours and of the outflow neighbours nearer
   // the disc (already updated), so the fluid's velocity at the disc carries through the whole buffer; kept
@@ -266,9 +322,14 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
   };
   std::vector<Item> order;
   for (std::size_t i = 0; i < n; ++i)
-    if (P.kind[i] == Kind::Outflow)
+    if (P.kind[i] == Kind::Outflow) {
       if (const int k = zone_of(P.x[i], Kind::Outflow); k >= 0)
         order.push_back({zones_[k].axial(P.x[i]), static_cast<uint32_t>(i), k});
+    } else if (P.kind[i] == Kind::Inflow) {
+      // Pressure inlets: the same, mirrored (distance from the disc upstream).
+      if (const int k = zone_of(P.x[i], Kind::Inflow); k >= 0 && zones_[k].spec.pressure_inlet)
+        order.push_back({-zones_[k].axial(P.x[i]), static_cast<uint32_t>(i), k});
+    }
   std::sort(order.begin(), order.end());
   std::vector<int32_t> rank(order.empty() ? 0 : n, -1);
   for (std::size_t r = 0; r < order.size(); ++r) rank[order[r].i] = static_cast<int32_t>(r);
@@ -278,7 +339,8 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
     Vec3 sv = Vec3::Zero();
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
-      if (P.kind[j] != Kind::Fluid && !(P.kind[j] == Kind::Outflow && rank[j] >= 0 && rank[j] < rank[i]))
+      if (P.kind[j] != Kind::Fluid &&
+          !((P.kind[j] == Kind::Outflow || P.kind[j] == Kind::Inflow) && rank[j] >= 0 && rank[j] < rank[i]))
         continue;
       const double W = K.W((P.x[i] - P.x[j]).norm()) * P.m[j] / P.rho[j];
       sw += W;
@@ -304,6 +366,18 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
         return;
       }
       const Zone& z = zones_[k];
+      if (z.spec.pressure_inlet) {
+        // Moves with its own (carried) velocity; becomes fluid across the disc, leaves past the far face.
+        P.v_wall[i] = P.v[i];
+        P.a[i] = Vec3::Zero();
+        P.x[i] += dt * P.v[i];
+        const double a = z.axial(P.x[i]);
+        if (a >= 0.0)
+          action[i] = kInflowToFluid;
+        else if (a < -z.depth || z.radial(P.x[i]) > z.spec.radius + 0.5 * dx_)
+          action[i] = kRemove;
+        return;
+      }
       P.v[i] = z.inflow_speed(P.x[i], t_new) * z.spec.normal;
       P.v_wall[i] = P.v[i];
       P.a[i] = Vec3::Zero();
@@ -331,9 +405,18 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
       // Fluid pushed back into an inflow buffer (a closed or slow inlet with the column sloshing) is removed
       // only once it is more than a spacing deep, past the buffer's first layer: small back-and-forth motion
       // across the disc must not drain the column.
-      else if (const int m = zone_of(P.x[i], Kind::Inflow);
-               m >= 0 && zones_[m].axial(P.x[i]) < -dx_ && zones_[m].radial(P.x[i]) < zones_[m].spec.radius)
-        action[i] = kRemoveBackflow;
+      else if (const int m = zone_of(P.x[i], Kind::Inflow); m >= 0) {
+        const Zone& z = zones_[m];
+        if (z.spec.pressure_inlet) {
+          // Backflow through a pressure inlet: the fluid joins the buffer at once (as at an outlet).
+          if (z.axial(P.x[i]) < 0.0 && z.radial(P.x[i]) <= z.spec.radius) {
+            action[i] = kFluidToInflow;
+            zone[i] = m;
+          }
+        } else if (z.axial(P.x[i]) < -dx_ && z.radial(P.x[i]) < z.spec.radius) {
+          action[i] = kRemoveBackflow;
+        }
+      }
     }
   });
 
@@ -342,10 +425,15 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
   // particles did not move back with it (an outlet at rest, its column jittering across the disc), a
   // replacement would stack on a particle already there, one more at every swing: in a valve cycle's
   // diastole that piled 14,000 extra particles into the aortic outlet in 30 ms.
+  // The same at pressure inlets, where every particle that enters the domain is replaced at the far face.
   std::vector<std::vector<Vec3>> resident(zones_.size());
-  if (std::find(action.begin(), action.end(), kOutflowToFluid) != action.end())
+  bool refills = std::find(action.begin(), action.end(), kOutflowToFluid) != action.end();
+  for (std::size_t m = 0; m < n && !refills; ++m)
+    refills = action[m] == kInflowToFluid && zone[m] >= 0 && zones_[zone[m]].spec.pressure_inlet;
+  if (refills)
     for (std::size_t m = 0; m < n; ++m)
-      if (P.kind[m] == Kind::Outflow && action[m] == kNone && zone[m] >= 0)
+      if (action[m] == kNone && zone[m] >= 0 &&
+          (P.kind[m] == Kind::Outflow || (P.kind[m] == Kind::Inflow && zones_[zone[m]].spec.pressure_inlet)))
         resident[zone[m]].push_back(P.x[m]);
   auto has_room = [&](int k, const Vec3& x) {
     for (const Vec3& q : resident[k])
@@ -374,7 +462,7 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
         const Zone& z = zones_[k];
         const bool inflow = action[i] == kInflowToFluid;
         const Vec3 x_new = P.x[i] + (inflow ? -z.depth : z.depth) * z.spec.normal;
-        if (!inflow) {
+        if (!inflow || z.spec.pressure_inlet) {
           if (!has_room(k, x_new)) break;
           resident[k].push_back(x_new);
         }
@@ -400,6 +488,12 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
         state_.volume_out += P.m[i] / P.rho[i];
         state_.mass_out += P.m[i];
         break;
+      case kFluidToInflow:
+        P.kind[i] = Kind::Inflow;
+        P.a[i] = Vec3::Zero();
+        state_.volume_out += P.m[i] / P.rho[i];
+        state_.mass_out += P.m[i];
+        break;
       case kRemove:
         ++removed;
         break;
@@ -419,6 +513,15 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
       if (i >= n || (action[i] != kRemove && action[i] != kRemoveBackflow))
         keep.push_back(static_cast<uint32_t>(i));
     P.permute(keep);
+  }
+
+  // The flows of this step; the Windkessels advance with them to t_new.
+  const std::vector<double> q = measure_flows(P);
+  for (std::size_t k = 0; k < zones_.size(); ++k) {
+    OpenBoundaryFlow& f = flows_[k];
+    f.flow = q[k];
+    f.interval_volume += q[k] * dt;
+    if (zones_[k].spec.windkessel) windkessel_step(*zones_[k].spec.windkessel, f.windkessel, q[k], dt);
   }
   impose(P, gravity, t_new);
   return created > 0 || removed > 0;

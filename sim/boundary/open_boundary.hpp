@@ -25,8 +25,26 @@
 //     when it passes the buffer's far face. If it returns across the disc (backflow) it turns back into
 //     fluid and a new outflow particle is created `layers` spacings further out, so the buffer stays full
 //     through back-and-forth flow.
-//   - Fluid particles that flow backwards more than one spacing into an inflow buffer are removed (counted as
-//     volume out).
+//   - Fluid particles that flow backwards more than one spacing into a velocity inlet's buffer are removed
+//     (counted as volume out).
+//   - Pressure inlet (an inflow given `pressure` instead of `velocity`, issue 17): pressure Dirichlet,
+//     velocity Neumann, the outflow's treatment mirrored across the disc. The buffer is laid on the lattice
+//     as a velocity inlet's; its particles take the prescribed p(t) plus the hydrostatic difference (density
+//     from the equation of state, mass rho dx^3 as a velocity inlet's), and their velocity is carried from
+//     the fluid next to the disc through the buffer (normal component, layer by layer, nearest the disc
+//     first, as at an outflow). A buffer particle that crosses the disc becomes fluid and a new one is
+//     created `layers` spacings behind it where the buffer has room; fluid that crosses the disc backwards
+//     (diastolic backflow) becomes a buffer particle (counted as volume out) and is removed when it passes
+//     the buffer's far face.
+//   - Windkessel outlet (an outflow given `windkessel`): the outlet's p(t) is the RCR model's
+//     (sim/physiology/windkessel.hpp), advanced every step with the flow Q out of the domain at that step.
+//   - Flow through each boundary (for the Windkessel and the `open_boundary` probe), positive in the
+//     boundary's direction (into the domain at an inflow, out of it at an outflow): the volume flux of the
+//     fluid in a slab one kernel support deep on the domain's side of the disc, Q = sum_i V_i (v_i . n)
+//     w(d_i) / (L / 2), d the distance from the disc, L = 2h, w(d) = sin^2(pi d / L) (a smooth window:
+//     particles enter and leave the slab with zero weight, so Q has no jumps when they do; integral of w over
+//     the slab: L / 2). Probes report its time average over the steps since the last output time (a multiple
+//     of time.output_interval).
 //
 // Every change of role, creation and removal is decided per particle and applied in one serial pass in index
 // order, new particles are appended in that order with ids from a counter: runs stay bitwise reproducible for
@@ -53,6 +71,15 @@ struct OpenBoundaryState {
   double mass_out = 0.0;
   uint64_t created = 0;  // particles created (inflows feeding, outflows refilled after backflow)
   uint64_t removed = 0;  // particles removed at outflows and inflows
+};
+
+// Per open boundary (in scene order): the flow through it, its pressure and its Windkessel state. Plain
+// values (for checkpoints).
+struct OpenBoundaryFlow {
+  double flow = 0.0;             // Q of the last step, positive in the boundary's direction [m^3/s]
+  double interval_volume = 0.0;  // integral of Q dt since OpenBoundaries::interval_start() [m^3]
+  double pressure = 0.0;         // the pressure it imposes now [Pa] (velocity inlet: the slab's mean)
+  WindkesselState windkessel;    // Windkessel outlets only
 };
 
 class OpenBoundaries {
@@ -84,6 +111,18 @@ class OpenBoundaries {
   const OpenBoundaryState& state() const { return state_; }
   OpenBoundaryState& state() { return state_; }
 
+  // Per boundary, in scene order (checkpoints restore them with interval_start()).
+  const std::vector<OpenBoundaryFlow>& flows() const { return flows_; }
+  std::vector<OpenBoundaryFlow>& flows() { return flows_; }
+  double interval_start() const { return interval_start_; }
+  double& interval_start() { return interval_start_; }
+  // Mean flow through boundary k over the steps since interval_start() up to time t (the last step's flow
+  // where no step has passed since) [m^3/s].
+  double mean_flow(std::size_t k, double t) const {
+    const double span = t - interval_start_;
+    return span > 0.0 ? flows_[k].interval_volume / span : flows_[k].flow;
+  }
+
  private:
   struct Zone {
     OpenBoundarySpec spec;
@@ -100,18 +139,27 @@ class OpenBoundaries {
       return (r - r.dot(spec.normal) * spec.normal).norm();
     }
     double inflow_speed(const Vec3& x, double t) const;
+    // Pressure inlet or outflow: the pressure is prescribed, the velocity carried from the fluid.
+    bool pressure_driven() const { return spec.type == OpenBoundaryType::Outflow || spec.pressure_inlet; }
   };
 
   // Index of the zone whose buffer holds particle x of the given kind, or -1.
   int zone_of(const Vec3& x, Kind kind) const;
-  // Pressure and density of every buffer particle at time t.
-  void impose(Particles& P, const Vec3& gravity, double t) const;
+  // Pressure and density of every buffer particle at time t (records each boundary's pressure in flows_).
+  void impose(Particles& P, const Vec3& gravity, double t);
+  // The flow through each boundary now (see above), per zone.
+  std::vector<double> measure_flows(const Particles& P) const;
+  // The prescribed pressure of a pressure inlet or an outflow at time t.
+  double prescribed_pressure(std::size_t k, double t) const;
 
   std::vector<Zone> zones_;
   std::vector<FluidParams> fluid_;
   double dx_ = 0.0;
   double support_ = 0.0;
+  double output_interval_ = 0.0;
   OpenBoundaryState state_;
+  std::vector<OpenBoundaryFlow> flows_;
+  double interval_start_ = 0.0;
 };
 
 }  // namespace aortasph

@@ -222,6 +222,9 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
         add_columns(columns_, pr.name,
                     {"volume_in", "volume_out", "volume_inside", "prescribed_rate", "mass_in", "mass_out",
                      "mass_inside"});
+        // Then, per open boundary N (issue 17): N.flow, N.pressure.
+        for (const OpenBoundarySpec& b : scene.open_boundaries)
+          for (const char* what : {".flow", ".pressure"}) columns_.push_back(pr.name + "." + b.name + what);
         break;
       case ProbeType::OrificeArea:
         columns_.push_back(pr.name);
@@ -408,6 +411,11 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const OpenBoundaryState& st = ob.state();
         out.insert(out.end(), {st.volume_in, st.volume_out, inside.v, ob.prescribed_inflow_rate(world.time()),
                                st.mass_in, st.mass_out, inside.m});
+        // Per boundary: the flow through it, positive in its own direction (into the domain at an inflow,
+        // out of it at an outflow), averaged over the steps since the last output time
+        // (sim/boundary/open_boundary.hpp), and the pressure it imposes now.
+        for (std::size_t b = 0; b < ob.flows().size(); ++b)
+          out.insert(out.end(), {ob.mean_flow(b, world.time()), ob.flows()[b].pressure});
         break;
       }
       case ProbeType::OrificeArea: {
