@@ -23,7 +23,7 @@ struct Box {
   }
 };
 
-enum class MaterialType { Fluid, Elastic, Rigid, Wall };
+enum class MaterialType { Fluid, Elastic, Rigid, Wall, Shell };
 
 struct Material {
   std::string name;
@@ -48,9 +48,25 @@ struct Material {
   // Gradient correction: true, second order (quadratic moving-least-squares fit); false, first order
   // (Bonet & Lok 1999). See Solids::Solids().
   bool second_order_gradient = true;
+
+  // Shell (one layer on the mid-surface, sim/solid/shell.hpp): density, youngs_modulus, poisson_ratio and
+  // neo_hookean as above (plane stress), hourglass its own default (see the loader).
+  double thickness = 0.0;      // [m]
+  double shell_damping = 0.0;  // mass-proportional damping of velocity and spin [1/s]
 };
 
-enum class ShapeKind { Box, Sphere, Cylinder, Container, Tube, AorticRoot, Mesh };
+enum class ShapeKind {
+  Box,
+  Sphere,
+  Cylinder,
+  Container,
+  Tube,
+  AorticRoot,
+  Mesh,
+  Rectangle,
+  Disc,
+  CylindricalPanel
+};
 
 // Parametric aortic root and valve (sim/geometry/aortic_root.hpp; docs/scenes.md). Lengths in metres, angles
 // in degrees. The root's axis is +y through `base` (the centre of the annulus disc); blood flows towards +y.
@@ -101,6 +117,29 @@ struct Shape {
   AorticRootParams aortic;        // aortic_root: the root's geometry
   AorticPart aortic_part = AorticPart::Wall;  // aortic_root: which part this body is
   int aortic_index = 0;                       // aortic_root leaflets: 0, 1, 2
+  // Shell shapes (one layer of particles; docs/scenes.md): rectangle (center, size, normal, u_axis), disc
+  // (center, radius, normal, rim), cylindrical_panel (center, axis, radius, length, angle, normal).
+  Vec3 normal = Vec3::UnitZ();
+  std::optional<Vec3> u_axis;           // rectangle: in-plane direction of size[0]
+  std::array<double, 2> size = {0, 0};  // rectangle
+  double angle = 0.0;                   // cylindrical_panel: whole opening angle [degrees]
+  int rim = 0;                          // disc: outermost ring 0 free, 1 fixed, 2 pinned
+};
+
+// A value that may vary in time: one constant, or a table of (t, value) pairs with strictly increasing times,
+// interpolated linearly and held at its first / last value outside the table.
+struct TimeSeries {
+  std::vector<double> t;      // empty for a constant
+  std::vector<double> value;  // one entry for a constant
+  double at(double time) const {
+    if (t.empty()) return value.empty() ? 0.0 : value[0];
+    if (time <= t.front()) return value.front();
+    if (time >= t.back()) return value.back();
+    std::size_t k = 1;
+    while (t[k] < time) ++k;
+    const double w = (time - t[k - 1]) / (t[k] - t[k - 1]);
+    return value[k - 1] + w * (value[k] - value[k - 1]);
+  }
 };
 
 enum class RenderMode { Particles, Surface, Hidden };
@@ -117,6 +156,9 @@ struct Body {
   std::optional<Vec3> color;  // rgb in 0..1
   RenderMode render = RenderMode::Particles;
   std::optional<Box> fixed;  // elastic bodies: particles inside are clamped
+  // Shell bodies: supports (each a list of boxes): fixed holds position and director, pinned the position.
+  std::vector<Box> shell_fixed, shell_pinned;
+  std::optional<TimeSeries> pressure_load;  // shell bodies: pressure along the normal [Pa]
 };
 
 struct Contact {
@@ -137,7 +179,8 @@ enum class ProbeType {
   OrificeArea,
   OpenBoundary,
   Stress,
-  Gap
+  Gap,
+  Displacement
 };
 
 struct Probe {
@@ -152,22 +195,6 @@ struct Probe {
   Vec3 normal = Vec3::UnitY();    // flow_rate, orifice_area
   Vec3 reference = Vec3::Zero();  // point
   double radius = 0.0;            // flow_rate, orifice_area
-};
-
-// A value that may vary in time: one constant, or a table of (t, value) pairs with strictly increasing times,
-// interpolated linearly and held at its first / last value outside the table.
-struct TimeSeries {
-  std::vector<double> t;      // empty for a constant
-  std::vector<double> value;  // one entry for a constant
-  double at(double time) const {
-    if (t.empty()) return value.empty() ? 0.0 : value[0];
-    if (time <= t.front()) return value.front();
-    if (time >= t.back()) return value.back();
-    std::size_t k = 1;
-    while (t[k] < time) ++k;
-    const double w = (time - t[k - 1]) / (t[k] - t[k - 1]);
-    return value[k - 1] + w * (value[k] - value[k - 1]);
-  }
 };
 
 enum class OpenBoundaryType { Inflow, Outflow };
