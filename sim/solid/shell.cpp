@@ -15,9 +15,13 @@ namespace aortasph {
 
 namespace {
 
-// 3-point Gauss-Legendre rule on [-1, 1] (through the thickness: zeta = t/2 xi).
-constexpr double kXi[3] = {0.0, -0.7745966692414834, 0.7745966692414834};
-constexpr double kW[3] = {8.0 / 9.0, 5.0 / 9.0, 5.0 / 9.0};
+// Gauss-Legendre rules on [-1, 1] through the thickness (zeta = t/2 xi): 2 points for Saint Venant-Kirchhoff
+// (exact for its energy, quadratic in zeta at small strain), 3 for neo-Hookean. Slot 0 is the mid-surface
+// (xi = 0) in both, for J0 at zeta = 0; the 2-point rule gives it weight 0.
+constexpr double kXi2[3] = {0.0, -0.5773502691896258, 0.5773502691896258};
+constexpr double kW2[3] = {0.0, 1.0, 1.0};
+constexpr double kXi3[3] = {0.0, -0.7745966692414834, 0.7745966692414834};
+constexpr double kW3[3] = {8.0 / 9.0, 5.0 / 9.0, 5.0 / 9.0};
 
 Mat3 columns(const Shells::Mat32& A, const Vec3& c) {
   Mat3 J;
@@ -132,12 +136,14 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
     }
     if (offset_[s] == offset_[s + 1]) G0 << T1_[s], T2_[s];
     const double det0 = columns(G0, N_[s]).determinant();
+    const double* xi = sp.neo_hookean ? kXi3 : kXi2;
+    const double* wq = sp.neo_hookean ? kW3 : kW2;
     for (int q = 0; q < kGauss; ++q) {
-      const double zeta = 0.5 * sp.t * kXi[q];
+      const double zeta = 0.5 * sp.t * xi[q];
       const Mat3 J0 = columns(G0 + zeta * H0, N_[s]);
       const double det = J0.determinant();
       K0_[kGauss * s + q] = std::abs(det) > 1e-12 ? Mat3(J0.inverse()) : Mat3::Identity();
-      vol_[kGauss * s + q] = area_[s] * kW[q] * 0.5 * sp.t * (std::abs(det0) > 1e-12 ? det / det0 : 1.0);
+      vol_[kGauss * s + q] = area_[s] * wq[q] * 0.5 * sp.t * (std::abs(det0) > 1e-12 ? det / det0 : 1.0);
     }
     const Mat3& K = K0_[kGauss * s];
     for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
@@ -220,8 +226,9 @@ void Shells::update(const Particles& P) {
     double U = 0.0, vm = 0.0;
     Mat2 Nr = Mat2::Zero(), Mr = Mat2::Zero();
     Eigen::Vector2d Qr = Eigen::Vector2d::Zero();
-    for (int k = 0; k < kGauss; ++k) {
-      const double zeta = 0.5 * sp.t * kXi[k];
+    const double* xi = sp.neo_hookean ? kXi3 : kXi2;
+    for (int k = sp.neo_hookean ? 0 : 1; k < kGauss; ++k) {
+      const double zeta = 0.5 * sp.t * xi[k];
       const Mat3& K = K0_[kGauss * s + k];
       const Mat3 F = columns(G_[s] + zeta * H_[s], d_[s]) * K;
       const Mat3 Eg = 0.5 * (F.transpose() * F - Mat3::Identity());
