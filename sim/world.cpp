@@ -469,13 +469,18 @@ void World::step_shells(double dt) {
     if (scene_.bodies[b].pressure_load) pressure[b] = scene_.bodies[b].pressure_load->at(time_);
   parallel_for(shells_.size(), [&](std::size_t s) {
     const uint32_t i = shells_.at(s);
-    if (shells_.support(s) != 0) {
+    if (shells_.support(s) == 1 || shells_.support(s) == 2) {
       P_.a[i] = Vec3::Zero();
       P_.v[i] = Vec3::Zero();
       return;
     }
     const Vec3 f = force_[i] + pressure[P_.body[i]] * shells_.area(s) * shells_.normal(s);
     P_.a[i] = f / shells_.mass(s) + gravity_ - shells_.damping(s) * P_.v[i];
+    if (shells_.support(s) == 3) {  // a diaphragm (validations): held in the plane across free_axis
+      const Vec3& ax = shells_.free_axis(s);
+      P_.a[i] = P_.a[i].dot(ax) * ax;
+      P_.v[i] = P_.v[i].dot(ax) * ax;
+    }
   });
   shells_.advance_directors(dt, kick_length(dt));
 }

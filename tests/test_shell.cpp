@@ -489,7 +489,100 @@ TEST_CASE("shell: a checkpoint resumes bitwise (directors and spin included)", "
   CHECK(state_hash(a) == state_hash(b));
   bool same = true;
   for (std::size_t k = 0; k < a.shells().size(); ++k)
-    same = same && a.shells().director(k) == b.shells().director(k) && a.shells().omega(k) == b.shells().omega(k);
+    same = same && a.shells().director(k) == b.shells().director(k) &&
+           a.shells().omega(k) == b.shells().omega(k);
   CHECK(same);
   CHECK(a.shells().director(0) != Vec3::UnitZ());  // it did move
+}
+
+// Validations (scripts/validate_shell.sh, results in docs/validation.md): too slow for the test suite.
+TEST_CASE("shell validation: a cantilever strip under an end moment 2 pi E I / L rolls into a circle",
+          "[.shell-validation]") {
+  // L = 12, b = 1, t = 0.5, E = 1.2e6, nu = 0 (Sze et al. 2004's roll-up, thicker so that it runs faster: the
+  // closed circle is independent of t). The moment, on the directors of the last row, ramps up over six first
+  // periods and is held for two; damping 2 omega_1.
+  const double L = 12, b = 1, t = 0.5, dx = 0.25, E = 1.2e6, rho = 1000.0;
+  Scene s = strip_scene(L, b, t, dx, E, rho);
+  const double EI = E * b * t * t * t / 12, M = 2 * std::numbers::pi * EI / L;
+  const double f1 = 1.8751 * 1.8751 / (2 * std::numbers::pi * L * L) * std::sqrt(E * t * t / (12 * rho));
+  s.materials[0].shell_damping = 2 * 2 * std::numbers::pi * f1;
+  s.domain = {Vec3(-20, -20, -20), Vec3(20, 20, 20)};
+  if (std::getenv("ROLL_CFL")) s.cfl = std::atof(std::getenv("ROLL_CFL"));
+  if (std::getenv("ROLL_HG")) s.materials[0].hourglass = std::atof(std::getenv("ROLL_HG"));
+  World w(s);
+  Shells& sh = w.shells_for_test();
+  std::vector<std::size_t> tip;
+  for (std::size_t k = 0; k < sh.size(); ++k)
+    if (sh.reference(k).x() > L - dx) tip.push_back(k);
+  const double T = 1 / f1;
+  const int chunks = 400;
+  for (int c = 1; c <= chunks; ++c) {
+    const double time = 8 * T * c / chunks, ramp = std::min(1.0, time / (6 * T));
+    for (std::size_t k : tip)
+      sh.set_external_moment(k, Vec3(0, -ramp * M / static_cast<double>(tip.size()), 0));
+    w.advance_to(time, [] { return true; });
+    if (c % 40 == 0) {
+      Vec3 tx = Vec3::Zero();
+      for (std::size_t k : tip) tx += w.particles().x[sh.at(k)] / static_cast<double>(tip.size());
+      // Pure bending of the exact solution: kappa = ramp 2 pi / L, tip at (sin(kappa L) / kappa, (1 - cos) / kappa).
+      const double kap = ramp * 2 * std::numbers::pi / L;
+      WARN("roll-up t = " << time << " moment " << ramp << " M: tip " << tx.transpose() << ", exact "
+                          << std::sin(kap * L) / kap << " " << (1 - std::cos(kap * L)) / kap);
+    }
+  }
+  Vec3 tip_x = Vec3::Zero(), root = Vec3(0, 0, 0);
+  for (std::size_t k : tip) tip_x += w.particles().x[sh.at(k)] / static_cast<double>(tip.size());
+  const double gap = (tip_x - Vec3(root.x(), tip_x.y(), root.z())).norm();
+  WARN("roll-up: tip at " << tip_x.transpose() << ", distance from the root " << gap << " = " << gap / L
+                          << " L, " << w.steps() << " steps, " << sh.size() << " particles");
+  CHECK(gap < 0.05 * L);
+}
+
+TEST_CASE("shell validation: Scordelis-Lo roof, mid free-edge vertical displacement 0.3024",
+          "[.shell-validation]") {
+  // R = 25, L = 50, 80 degrees, t = 0.25, E = 4.32e8, nu = 0, gravity load 90 per area (rho 36, g 10); the
+  // curved ends on rigid diaphragms (held across the axis, free along it), the long edges free. 17 particles
+  // on the arc, 25 rows along (the end rows on the diaphragms at x = +-25). Damped to static.
+  const double R = 25, Lr = 50, dx = Lr / 24;
+  Scene s;
+  s.name = "roof";
+  s.spacing = dx;
+  s.gravity = Vec3(0, 0, -10);
+  s.domain = {Vec3(-40, -40, -40), Vec3(40, 40, 40)};
+  s.max_dt = 1.0;
+  s.cfl = 0.5;
+  Material m = shell_material(4.32e8, 0.0, 0.25, 36.0);
+  m.shell_damping = std::getenv("ROOF_DAMPING") ? std::atof(std::getenv("ROOF_DAMPING")) : 12.0;
+  s.materials = {m};
+  Body b;
+  b.name = "roof";
+  b.material = 0;
+  b.shape.kind = ShapeKind::CylindricalPanel;
+  b.shape.center = Vec3(0, 0, -R);
+  b.shape.axis = Vec3::UnitX();
+  b.shape.radius = R;
+  b.shape.length = Lr + dx;
+  b.shape.angle = 80;
+  b.shape.normal = Vec3::UnitZ();
+  s.bodies = {b};
+  World w(s);
+  Shells& sh = w.shells_for_test();
+  for (std::size_t k = 0; k < sh.size(); ++k)
+    if (std::abs(sh.reference(k).x()) > 0.5 * Lr - 0.25 * dx) sh.set_support(k, 3, Vec3::UnitX());
+  // The mid free edge: the particle nearest (0, R sin 40, R cos 40 - R).
+  const double th = 40 * std::numbers::pi / 180;
+  const std::size_t probe = nearest(w, Vec3(0, R * std::sin(th), R * std::cos(th) - R));
+  const double end = std::getenv("ROOF_END") ? std::atof(std::getenv("ROOF_END")) : 4.0;
+  double prev = 0.0;
+  for (int c = 1; c <= 8; ++c) {
+    w.advance_to(end * c / 8, [] { return true; });
+    const double uz = w.particles().x[probe].z() - w.particles().x0[probe].z();
+    WARN("roof t = " << w.time() << ": uz = " << uz << " (change " << uz - prev << "), steps " << w.steps());
+    prev = uz;
+  }
+  const double uz = w.particles().x[probe].z() - w.particles().x0[probe].z();
+  WARN("Scordelis-Lo: mid free-edge uz = " << uz << " at " << w.particles().x0[probe].transpose()
+                                           << ", reference -0.3024, ratio " << -uz / 0.3024 << ", "
+                                           << sh.size() << " particles");
+  CHECK(-uz == Approx(0.3024).epsilon(0.05));
 }

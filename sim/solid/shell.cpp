@@ -317,7 +317,8 @@ void Shells::advance_directors(double dt, double kick) {
       return;
     }
     const double c = params_[material_[s]].damping;
-    Vec3 w = omega_[s] + kick * (torque_[s] / inertia_[s] - c * omega_[s]);
+    const Vec3 tau = external_.empty() ? torque_[s] : Vec3(torque_[s] + external_[s]);
+    Vec3 w = omega_[s] + kick * (tau / inertia_[s] - c * omega_[s]);
     w -= w.dot(d_[s]) * d_[s];  // no spin about the director (it has no inertia, nothing to turn)
     omega_[s] = w;
     const double angle = w.norm() * dt;

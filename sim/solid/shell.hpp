@@ -107,8 +107,23 @@ class Shells {
   const std::vector<Vec3>& directors() const { return d_; }
   const std::vector<Vec3>& omegas() const { return omega_; }
 
-  // For tests: set the current director of slot s.
+  // For tests and validations: set the current director of slot s; an external moment on slot s [N m] (held
+  // until changed); a support of slot s (0 free, 1 fixed, 2 pinned, 3 a diaphragm: the position held in the
+  // plane perpendicular to axis, free along it, the director free).
   void set_director(std::size_t s, const Vec3& d) { d_[s] = d.normalized(); }
+  void set_external_moment(std::size_t s, const Vec3& m) {
+    if (external_.empty()) external_.assign(X_.size(), Vec3::Zero());
+    external_[s] = m;
+  }
+  void set_support(std::size_t s, uint8_t support, const Vec3& axis = Vec3::UnitX()) {
+    support_[s] = support;
+    if (support == 3) {
+      if (free_axis_.empty()) free_axis_.assign(X_.size(), Vec3::Zero());
+      free_axis_[s] = axis.normalized();
+    }
+  }
+  // Diaphragm supports: the direction left free.
+  const Vec3& free_axis(std::size_t s) const { return free_axis_[s]; }
 
  private:
   static constexpr uint32_t kNone = 0xffffffffu;
@@ -134,6 +149,7 @@ class Shells {
   std::vector<uint32_t> at_, slot_, s_of_id_;
   // State.
   std::vector<Vec3> d_, omega_;
+  std::vector<Vec3> external_, free_axis_;  // empty unless set (tests, validations)
   // Per update.
   std::vector<Vec3> x_;  // positions gathered by slot
   std::vector<Mat32> G_, H_, PG_, PH_;
