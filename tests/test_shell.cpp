@@ -465,14 +465,18 @@ TEST_CASE("shell: bad input exits 2 naming the key", "[shell][bad-input]") {
     CHECK(code == 2);
     CHECK(err.find(r.expect) != std::string::npos);
   }
-  // The good scene runs and writes the displacement columns.
+  // The good scene runs and writes the displacement columns (and, with --vtk, the directors).
   std::ofstream(dir / "scene.json") << good;
   std::string err;
-  CHECK(
-      run_cli("run " + (dir / "scene.json").string() + " --no-render --quiet --out " + (dir / "out").string(),
-              err) == 0);
+  CHECK(run_cli("run " + (dir / "scene.json").string() + " --no-render --vtk --quiet --out " +
+                    (dir / "out").string(),
+                err) == 0);
   const std::string csv = slurp(dir / "out" / "probes.csv");
   CHECK(csv.find("tip.ux,tip.uy,tip.uz") != std::string::npos);
+  // VTK output carries the shells' director and thickness.
+  const std::string vtp = slurp(dir / "out" / "vtk" / "particles_00001.vtp");
+  CHECK(vtp.find("Name=\"director\"") != std::string::npos);
+  CHECK(vtp.find("Name=\"thickness\"") != std::string::npos);
 }
 
 TEST_CASE("shell: a checkpoint resumes bitwise (directors and spin included)", "[shell][checkpoint]") {
@@ -524,7 +528,8 @@ TEST_CASE("shell validation: a cantilever strip under an end moment 2 pi E I / L
     if (c % 40 == 0) {
       Vec3 tx = Vec3::Zero();
       for (std::size_t k : tip) tx += w.particles().x[sh.at(k)] / static_cast<double>(tip.size());
-      // Pure bending of the exact solution: kappa = ramp 2 pi / L, tip at (sin(kappa L) / kappa, (1 - cos) / kappa).
+      // Pure bending of the exact solution: kappa = ramp 2 pi / L, tip at (sin(kappa L) / kappa, (1 - cos) /
+      // kappa).
       const double kap = ramp * 2 * std::numbers::pi / L;
       WARN("roll-up t = " << time << " moment " << ramp << " M: tip " << tx.transpose() << ", exact "
                           << std::sin(kap * L) / kap << " " << (1 - std::cos(kap * L)) / kap);
