@@ -19,10 +19,10 @@
 //     neo-Hookean law with lambda3 = 1 / (lambda1 lambda2) (sim/solid/shell_material.hpp), transverse shear
 //     with the 5/6 correction;
 //   - the internal forces and director moments are the exact derivatives of the elastic energy
-//     U = sum_i sum_k A_i w_k psi(E_k) (3-point Gauss rule through the thickness): the nominal resultants
-//     dU/dG_i (membrane), dU/dH_i (moment) and dU/dd_i (transverse shear) contracted with the gradient
-//     weights. So the internal forces conserve linear and angular momentum (U is invariant under translation
-//     and rotation) and, undamped, energy;
+//     U = sum_i sum_k A_i w_k psi(E_k) (2-point Gauss rule through the thickness for SVK, 3 for neo-Hookean):
+//     the nominal resultants dU/dG_i (membrane), dU/dH_i (moment) and dU/dd_i (transverse shear) contracted
+//     with the gradient weights. So the internal forces conserve linear and angular momentum (U is invariant
+//     under translation and rotation) and, undamped, energy;
 //   - hourglass control is an energy too (as in sim/solid/solid_tlsph.cpp): U_hg = sum over pairs
 //     1/2 k_ij |eps_ij|^2 with eps_ij = (F_i + F_j) X_ij / 2 - x_ij, zero for every affine motion and third
 //     order for smooth ones, against the zig-zag modes that nodal integration cannot see;
