@@ -125,6 +125,21 @@ void VtkWriter::write(const World& world, int frame) {
   for (std::size_t i = 0; i < n; ++i) f << P.body[i] << '\n';
   f << "</DataArray>\n<DataArray type=\"Int32\" Name=\"id\" format=\"ascii\">\n";
   for (std::size_t i = 0; i < n; ++i) f << P.id[i] << '\n';
+  // Shells (sim/solid/shell.hpp): the director (the through-thickness direction) and the thickness of each
+  // shell particle; zero for the others.
+  if (const Shells& sh = world.shells(); !sh.empty()) {
+    std::vector<Vec3> d(n, Vec3::Zero());
+    std::vector<double> t(n, 0.0);
+    for (std::size_t s = 0; s < sh.size(); ++s) {
+      d[sh.at(s)] = sh.director(s);
+      t[sh.at(s)] = sh.thickness(s);
+    }
+    f << "</DataArray>\n<DataArray type=\"Float64\" Name=\"director\" NumberOfComponents=\"3\" "
+         "format=\"ascii\">\n";
+    for (std::size_t i = 0; i < n; ++i) f << d[i].x() << ' ' << d[i].y() << ' ' << d[i].z() << '\n';
+    f << "</DataArray>\n<DataArray type=\"Float64\" Name=\"thickness\" format=\"ascii\">\n";
+    for (std::size_t i = 0; i < n; ++i) f << t[i] << '\n';
+  }
   f << "</DataArray>\n</PointData>\n<Verts>\n<DataArray type=\"Int32\" Name=\"connectivity\" "
        "format=\"ascii\">\n";
   for (std::size_t i = 0; i < n; ++i) f << i << '\n';

@@ -623,7 +623,7 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
               scene.domain.min.x(), scene.domain.min.y(), scene.domain.min.z(), scene.domain.max.x(),
               scene.domain.max.y(), scene.domain.max.z());
   std::printf("  %-20s %-12s %-8s %10s\n", "body", "material", "type", "particles");
-  static const char* kTypes[] = {"fluid", "elastic", "rigid", "wall"};
+  static const char* kTypes[] = {"fluid", "elastic", "rigid", "wall", "shell"};
   for (const BodyInfo& b : world.bodies())
     std::printf("  %-20s %-12s %-8s %10zu\n", b.name.c_str(), scene.materials[b.material].name.c_str(),
                 kTypes[static_cast<int>(b.type)], b.count);
@@ -684,8 +684,10 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
   // doubled the aortic root's wall time).
   const bool has_fluid = nf + nin + nout > 0;
   const double pairs = has_fluid ? static_cast<double>(world.neighbors().pairs()) : 0.0;
-  const double step_2threads = 1.07e-8 * pairs + 7.5e-8 * static_cast<double>(n) +
-                               1.6e-6 * static_cast<double>(world.count(Kind::Elastic));
+  const double step_2threads =
+      1.07e-8 * pairs + 7.5e-8 * static_cast<double>(n) +
+      1.6e-6 * static_cast<double>(world.count(Kind::Elastic)) +
+      0.6e-6 * static_cast<double>(world.count(Kind::Shell));  // shells: a guess from the [shell] tests
   const int threads = max_threads();
   const double seconds = steps * step_2threads * 2.0 / threads;
   std::printf(

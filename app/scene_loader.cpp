@@ -10,6 +10,7 @@
 
 #include "errors.hpp"
 #include "geometry/aortic_root.hpp"
+#include "geometry/shapes.hpp"
 #include "waveform_csv.hpp"
 
 namespace aortasph {
@@ -389,10 +390,10 @@ class Loader {
                                    ? it.value()["type"].get<std::string>()
                                    : "";
       if (!it.value().contains("type"))
-        fail(path + ".type", "missing (expected fluid, elastic, rigid or wall)");
-      if (type != "fluid" && type != "elastic" && type != "rigid" && type != "wall")
+        fail(path + ".type", "missing (expected fluid, elastic, rigid, wall or shell)");
+      if (type != "fluid" && type != "elastic" && type != "rigid" && type != "wall" && type != "shell")
         fail(path + ".type", "unknown value " + it.value()["type"].dump() +
-                                 " (expected one of: fluid, elastic, rigid, wall)");
+                                 " (expected one of: fluid, elastic, rigid, wall, shell)");
       Material m;
       m.name = it.key();
       std::vector<std::string> keys = {"type"};
@@ -412,8 +413,11 @@ class Loader {
                 "model", "gradient"};
       else if (type == "rigid")
         keys = {"type", "density"};
+      else if (type == "shell")
+        keys = {"type",      "density", "youngs_modulus", "poisson_ratio",
+                "thickness", "model",   "damping",        "hourglass"};
       Obj o(it.value(), path, keys, allowed);
-      o.choice("type", {"fluid", "elastic", "rigid", "wall"});
+      o.choice("type", {"fluid", "elastic", "rigid", "wall", "shell"});
       if (type == "fluid") {
         m.type = MaterialType::Fluid;
         m.density = o.positive("density");
@@ -439,6 +443,8 @@ class Loader {
         m.neo_hookean = o.choice("model", {"saint_venant_kirchhoff", "neo_hookean"}) == "neo_hookean";
         if (!o.has("gradient")) it.value()["gradient"] = "second_order";
         m.second_order_gradient = o.choice("gradient", {"first_order", "second_order"}) == "second_order";
+      } else if (type == "shell") {
+        shell_material(o, it.value(), m, s);
       } else if (type == "rigid") {
         m.type = MaterialType::Rigid;
         m.density = o.positive("density");
@@ -447,6 +453,33 @@ class Loader {
       }
       s.materials.push_back(m);
     }
+  }
+
+  // A shell material (sim/solid/shell.hpp): plane-stress SVK or incompressible neo-Hookean, thickness a
+  // parameter of at most kMaxShellThickness spacings (a thicker sheet is resolved by a volumetric solid).
+  static constexpr double kMaxShellThickness = 4.0;
+  void shell_material(Obj& o, json& j, Material& m, const Scene& s) {
+    m.type = MaterialType::Shell;
+    m.density = o.positive("density");
+    m.youngs_modulus = o.positive("youngs_modulus");
+    if (!o.has("model")) j["model"] = "saint_venant_kirchhoff";
+    m.neo_hookean = o.choice("model", {"saint_venant_kirchhoff", "neo_hookean"}) == "neo_hookean";
+    m.poisson_ratio = o.number("poisson_ratio");
+    if (m.neo_hookean) {
+      if (!(m.poisson_ratio >= 0.45 && m.poisson_ratio <= 0.5))
+        fail(o.path("poisson_ratio"),
+             "the neo_hookean shell is incompressible: expected 0.45..0.5 (it uses 0.5), got " +
+                 json(m.poisson_ratio).dump());
+    } else if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5)) {
+      fail(o.path("poisson_ratio"), "must lie in (-1, 0.5), got " + json(m.poisson_ratio).dump());
+    }
+    m.thickness = o.positive("thickness");
+    if (m.thickness > kMaxShellThickness * s.spacing)
+      fail(o.path("thickness"), "is " + json(m.thickness / s.spacing).dump() +
+                                    " spacings: a shell may be at most " + json(kMaxShellThickness).dump() +
+                                    " spacings thick (resolve a thicker sheet with an elastic body)");
+    m.shell_damping = o.non_negative("damping", 0.0);
+    m.hourglass = o.non_negative("hourglass", 0.05);
   }
 
   int material_index(const Scene& s, const std::string& name, const std::string& path) {
@@ -464,7 +497,7 @@ class Loader {
   Body body(json& j, const std::string& path, const Scene& s) {
     Obj o(j, path,
           {"name", "material", "shape", "translate", "rotate", "velocity", "angular_velocity", "color",
-           "render", "fixed", "initial_flow"},
+           "render", "fixed", "initial_flow", "pinned", "pressure_load"},
           allowed);
     Body b;
     b.name = o.string("name");
@@ -501,6 +534,22 @@ class Loader {
     b.render = mode == "surface"  ? RenderMode::Surface
                : mode == "hidden" ? RenderMode::Hidden
                                   : RenderMode::Particles;
+    const bool shell = s.materials[b.material].type == MaterialType::Shell;
+    if (shell != is_shell_shape(b.shape.kind)) {
+      if (shell && b.shape.kind == ShapeKind::AorticRoot)
+        fail(o.path("material"), "shell aortic leaflets are not supported yet (issue 16, later work)");
+      fail(o.path("material"),
+           shell ? "a shell material needs a shell shape (rectangle, disc or cylindrical_panel)"
+                 : "a shell shape (rectangle, disc, cylindrical_panel) needs a shell material");
+    }
+    if (shell) {
+      if (o.has("fixed")) b.shell_fixed = boxes(o, "fixed");
+      if (o.has("pinned")) b.shell_pinned = boxes(o, "pinned");
+      if (o.has("pressure_load")) b.pressure_load = series(o, "pressure_load", std::nullopt, false);
+      return b;
+    }
+    if (o.has("pinned")) fail(o.path("pinned"), "only shell bodies can be pinned");
+    if (o.has("pressure_load")) fail(o.path("pressure_load"), "only shell bodies carry a pressure_load");
     if (o.has("fixed")) {
       json& f = o.raw("fixed");
       if (f.is_object() && f.contains("box")) {
@@ -517,9 +566,85 @@ class Loader {
     return b;
   }
 
+  // A support: one box ({"min", "max"} or {"box": {...}}) or a list of them.
+  std::vector<Box> boxes(Obj& o, const std::string& key) {
+    json& f = o.raw(key);
+    std::vector<Box> out;
+    auto one = [&](json& e, const std::string& path) {
+      if (e.is_object() && e.contains("box")) {
+        Obj fo(e, path, {"box"}, allowed);
+        Obj bo(fo.raw("box"), fo.path("box"), {"min", "max"}, allowed);
+        out.push_back(bo.box());
+      } else {
+        Obj fo(e, path, {"min", "max"}, allowed);
+        out.push_back(fo.box());
+      }
+    };
+    if (f.is_array()) {
+      if (f.empty()) fail(o.path(key), "expected a box or a non-empty list of boxes");
+      for (std::size_t k = 0; k < f.size(); ++k) one(f[k], index(o.path(key), k));
+    } else {
+      one(f, o.path(key));
+    }
+    return out;
+  }
+
+  // Shell shapes: one layer of particles on the mid-surface.
+  void shell_shape(const std::string& kind, json& j, const std::string& p, Shape& sh, double dx) {
+    if (kind == "rectangle") {
+      Obj b(j, p, {"center", "size", "normal", "u_axis"}, allowed);
+      sh.kind = ShapeKind::Rectangle;
+      sh.center = b.vec3("center");
+      const json& sz = b.raw("size");
+      if (!sz.is_array() || sz.size() != 2 || !sz[0].is_number() || !sz[1].is_number())
+        fail(b.path("size"), "expected two numbers [a, b]");
+      sh.size = {sz[0].get<double>(), sz[1].get<double>()};
+      for (int k = 0; k < 2; ++k)
+        if (!(sh.size[k] > 0) || !std::isfinite(sh.size[k]))
+          fail(index(b.path("size"), k), "must be positive");
+      sh.normal = b.unit("normal");
+      if (b.has("u_axis")) {
+        const Vec3 u = b.unit("u_axis");
+        if ((u - u.dot(sh.normal) * sh.normal).norm() < 1e-6) fail(b.path("u_axis"), "is parallel to normal");
+        sh.u_axis = u;
+      }
+      for (int k = 0; k < 2; ++k)
+        if (std::lround(sh.size[k] / dx) < 1)
+          fail(index(b.path("size"), k), "samples no particle at spacing " + json(dx).dump());
+    } else if (kind == "disc") {
+      Obj b(j, p, {"center", "radius", "normal", "rim"}, allowed);
+      sh.kind = ShapeKind::Disc;
+      sh.center = b.vec3("center");
+      sh.radius = b.positive("radius");
+      sh.normal = b.unit("normal");
+      const std::string rim = b.choice("rim", {"free", "fixed", "pinned"}, "free");
+      sh.rim = rim == "fixed" ? 1 : rim == "pinned" ? 2 : 0;
+      if (std::lround(sh.radius / dx) < 1)
+        fail(b.path("radius"), "samples no ring of particles at spacing " + json(dx).dump() +
+                                   " (the radius must be at least half a spacing)");
+    } else {
+      Obj b(j, p, {"center", "axis", "radius", "length", "angle", "normal"}, allowed);
+      sh.kind = ShapeKind::CylindricalPanel;
+      sh.center = b.vec3("center");
+      sh.axis = b.unit("axis");
+      sh.radius = b.positive("radius");
+      sh.length = b.positive("length");
+      sh.angle = b.positive("angle");
+      if (sh.angle > 360) fail(b.path("angle"), "must lie in (0, 360] degrees");
+      sh.normal = b.unit("normal");
+      if (std::abs(sh.normal.dot(sh.axis)) > 1e-6)
+        fail(b.path("normal"), "must be perpendicular to axis (the direction from the axis to the crown)");
+      if (std::lround(sh.length / dx) < 1)
+        fail(b.path("length"), "samples no particle at spacing " + json(dx).dump());
+      if (std::lround(sh.radius * sh.angle * std::numbers::pi / 180.0 / dx) < 1)
+        fail(b.path("angle"), "the arc samples no particle at spacing " + json(dx).dump());
+    }
+  }
+
   Shape shape(json& j, const std::string& path, double dx) {
-    static const std::vector<std::string> kinds = {"box",  "sphere",      "cylinder", "container",
-                                                   "tube", "aortic_root", "mesh"};
+    static const std::vector<std::string> kinds = {"box",  "sphere",           "cylinder", "container",
+                                                   "tube", "aortic_root",      "mesh",     "rectangle",
+                                                   "disc", "cylindrical_panel"};
     Obj o(j, path, kinds, allowed);
     if (j.size() != 1)
       fail(path,
@@ -563,6 +688,15 @@ class Loader {
       }
     } else if (kind == "aortic_root") {
       sh = aortic_root_shape(o.raw(kind), p, dx);
+    } else if (kind == "rectangle" || kind == "disc" || kind == "cylindrical_panel") {
+      shell_shape(kind, o.raw(kind), p, sh, dx);
+      const double area = kind == "rectangle" ? sh.size[0] * sh.size[1]
+                          : kind == "disc"    ? std::numbers::pi * sh.radius * sh.radius
+                                              : sh.length * sh.radius * sh.angle * std::numbers::pi / 180.0;
+      if (area / (dx * dx) > 2e8)
+        fail(p, "holds about " + json(area / (dx * dx)).dump() + " particles at spacing " + json(dx).dump() +
+                    ": too many particles");
+      return sh;
     } else {
       fail(p, "shape '" + kind + "' is not supported yet");
     }
@@ -737,13 +871,15 @@ class Loader {
     if (type == "max_speed") keys.insert(keys.end(), {"bodies", "region"});
     if (type == "coaptation")
       keys.insert(keys.end(), {"bodies", "point", "normal", "distance", "central_radius"});
+    if (type == "displacement") keys.insert(keys.end(), {"body", "point"});
     Obj o(j, path, keys, allowed);
     Probe p;
     p.name = o.string("name");
     if (p.name.empty() || p.name.find_first_of(",\"\n") != std::string::npos)
       fail(o.path("name"), "must be a non-empty name without commas or quotes");
-    o.choice("type", {"extent", "pressure", "body", "point", "energy", "momentum", "flow_rate",
-                      "orifice_area", "open_boundary", "stress", "gap", "max_speed", "coaptation"});
+    o.choice("type",
+             {"extent", "pressure", "body", "point", "energy", "momentum", "flow_rate", "orifice_area",
+              "open_boundary", "stress", "gap", "max_speed", "coaptation", "displacement"});
     if (type == "extent") {
       p.type = ProbeType::Extent;
       const auto names = o.strings("bodies");
@@ -767,6 +903,11 @@ class Loader {
       p.type = ProbeType::Point;
       p.body = body_index(s, o.string("body"), o.path("body"));
       p.reference = o.vec3("reference");
+    } else if (type == "displacement") {
+      // .ux .uy .uz of the body particle nearest `point` at t = 0.
+      p.type = ProbeType::Displacement;
+      p.body = body_index(s, o.string("body"), o.path("body"));
+      p.point = o.vec3("point");
     } else if (type == "energy") {
       p.type = ProbeType::Energy;
     } else if (type == "momentum") {
@@ -785,7 +926,8 @@ class Loader {
       if (names.empty()) fail(o.path("bodies"), "expected at least one body");
       for (std::size_t k = 0; k < names.size(); ++k) {
         p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
-        if (s.materials[s.bodies[p.bodies.back()].material].type != MaterialType::Elastic)
+        if (s.materials[s.bodies[p.bodies.back()].material].type != MaterialType::Elastic &&
+            s.materials[s.bodies[p.bodies.back()].material].type != MaterialType::Shell)
           fail(index(o.path("bodies"), k), "body '" + names[k] + "' is not elastic: it carries no stress");
       }
     } else if (type == "max_speed") {

@@ -26,7 +26,7 @@ struct Box {
   }
 };
 
-enum class MaterialType { Fluid, Elastic, Rigid, Wall };
+enum class MaterialType { Fluid, Elastic, Rigid, Wall, Shell };
 
 struct Material {
   std::string name;
@@ -52,9 +52,25 @@ struct Material {
   // Gradient correction: true, second order (quadratic moving-least-squares fit); false, first order
   // (Bonet & Lok 1999). See Solids::Solids().
   bool second_order_gradient = true;
+
+  // Shell (one layer on the mid-surface, sim/solid/shell.hpp): density, youngs_modulus, poisson_ratio and
+  // neo_hookean as above (plane stress), hourglass its own default (see the loader).
+  double thickness = 0.0;      // [m]
+  double shell_damping = 0.0;  // mass-proportional damping of velocity and spin [1/s]
 };
 
-enum class ShapeKind { Box, Sphere, Cylinder, Container, Tube, AorticRoot, Mesh };
+enum class ShapeKind {
+  Box,
+  Sphere,
+  Cylinder,
+  Container,
+  Tube,
+  AorticRoot,
+  Mesh,
+  Rectangle,
+  Disc,
+  CylindricalPanel
+};
 
 // Parametric aortic root and valve (sim/geometry/aortic_root.hpp; docs/scenes.md). Lengths in metres, angles
 // in degrees. The root's axis is +y through `base` (the centre of the annulus disc); blood flows towards +y.
@@ -105,6 +121,29 @@ struct Shape {
   AorticRootParams aortic;        // aortic_root: the root's geometry
   AorticPart aortic_part = AorticPart::Wall;  // aortic_root: which part this body is
   int aortic_index = 0;                       // aortic_root leaflets: 0, 1, 2
+  // Shell shapes (one layer of particles; docs/scenes.md): rectangle (center, size, normal, u_axis), disc
+  // (center, radius, normal, rim), cylindrical_panel (center, axis, radius, length, angle, normal).
+  Vec3 normal = Vec3::UnitZ();
+  std::optional<Vec3> u_axis;           // rectangle: in-plane direction of size[0]
+  std::array<double, 2> size = {0, 0};  // rectangle
+  double angle = 0.0;                   // cylindrical_panel: whole opening angle [degrees]
+  int rim = 0;                          // disc: outermost ring 0 free, 1 fixed, 2 pinned
+};
+
+// A value that may vary in time: one constant, or a table of (t, value) pairs with strictly increasing times,
+// interpolated linearly and held at its first / last value outside the table.
+struct TimeSeries {
+  std::vector<double> t;      // empty for a constant
+  std::vector<double> value;  // one entry for a constant
+  double at(double time) const {
+    if (t.empty()) return value.empty() ? 0.0 : value[0];
+    if (time <= t.front()) return value.front();
+    if (time >= t.back()) return value.back();
+    std::size_t k = 1;
+    while (t[k] < time) ++k;
+    const double w = (time - t[k - 1]) / (t[k] - t[k - 1]);
+    return value[k - 1] + w * (value[k] - value[k - 1]);
+  }
 };
 
 enum class RenderMode { Particles, Surface, Hidden };
@@ -131,6 +170,9 @@ struct Body {
   RenderMode render = RenderMode::Particles;
   std::optional<Box> fixed;                 // elastic bodies: particles inside are clamped
   std::optional<InitialFlow> taylor_green;  // fluid bodies: initial_flow.taylor_green
+  // Shell bodies: supports (each a list of boxes): fixed holds position and director, pinned the position.
+  std::vector<Box> shell_fixed, shell_pinned;
+  std::optional<TimeSeries> pressure_load;  // shell bodies: pressure along the normal [Pa]
 };
 
 struct Contact {
@@ -152,8 +194,9 @@ enum class ProbeType {
   OpenBoundary,
   Stress,
   Gap,
-  MaxSpeed,    // largest fluid speed in a region (the jet through a valve)
-  Coaptation,  // leaflet coaptation heights and lengths, effective height (docs/valve-metrics.md)
+  MaxSpeed,      // largest fluid speed in a region (the jet through a valve)
+  Coaptation,    // leaflet coaptation heights and lengths, effective height (docs/valve-metrics.md)
+  Displacement,  // displacement of the body particle nearest a point at t = 0
 };
 
 struct Probe {
@@ -170,22 +213,6 @@ struct Probe {
   double radius = 0.0;            // flow_rate, orifice_area
   double distance = 0.0;          // coaptation: contact distance [m]
   double central_radius = 0.0;    // coaptation: radius about the axis counted as the centre [m]
-};
-
-// A value that may vary in time: one constant, or a table of (t, value) pairs with strictly increasing times,
-// interpolated linearly and held at its first / last value outside the table.
-struct TimeSeries {
-  std::vector<double> t;      // empty for a constant
-  std::vector<double> value;  // one entry for a constant
-  double at(double time) const {
-    if (t.empty()) return value.empty() ? 0.0 : value[0];
-    if (time <= t.front()) return value.front();
-    if (time >= t.back()) return value.back();
-    std::size_t k = 1;
-    while (t[k] < time) ++k;
-    const double w = (time - t[k - 1]) / (t[k] - t[k - 1]);
-    return value[k - 1] + w * (value[k] - value[k - 1]);
-  }
 };
 
 enum class OpenBoundaryType { Inflow, Outflow };

@@ -37,6 +37,8 @@ std::array<float, 3> default_color(MaterialType t) {
       return {0.90f, 0.50f, 0.15f};
     case MaterialType::Elastic:
       return {0.30f, 0.70f, 0.35f};
+    case MaterialType::Shell:
+      return {0.75f, 0.35f, 0.55f};
   }
   return {0.5f, 0.5f, 0.5f};
 }
@@ -51,6 +53,8 @@ Kind kind_of(MaterialType t) {
       return Kind::Rigid;
     case MaterialType::Elastic:
       return Kind::Elastic;
+    case MaterialType::Shell:
+      return Kind::Shell;
   }
   return Kind::Wall;
 }
@@ -64,7 +68,8 @@ World::World(const Scene& scene)
       ctx_{kernel_, fluid_, gravity_, {}, {}, Periodic(scene.domain, scene.periodic)} {
   const double dx = scene_.spacing;
   const double volume = dx * dx * dx;
-  std::vector<uint8_t> clamped;  // per particle: elastic and held in place
+  std::vector<uint8_t> clamped;       // per particle: elastic and held in place
+  std::vector<ShellSeed> shell_seed;  // per particle: shells' normal, area and support
 
   // Read-only per-material constants.
   fluid_.resize(scene_.materials.size());
@@ -149,6 +154,7 @@ World::World(const Scene& scene)
       if (body.fixed && held == 0)
         throw SetupError(where + ".fixed: the region holds no particle of the body");
     }
+    if (mat.type == MaterialType::Shell) add_shell_seeds(body, where, sample, first, shell_seed);
 
     // Fluid under gravity starts in hydrostatic balance: p = rho0 |g| depth below the body's top, and the
     // density that the equation of state gives for it. Without this the column would first oscillate.
@@ -211,6 +217,13 @@ World::World(const Scene& scene)
     clamped = std::move(by_index);
   }
   solids_ = Solids(P_, scene_.materials, kernel_, dx, clamped);
+  if (!shell_seed.empty()) {
+    std::vector<ShellSeed> by_index(P_.size());
+    for (std::size_t i = 0; i < P_.size(); ++i)
+      if (P_.id[i] < shell_seed.size()) by_index[i] = shell_seed[P_.id[i]];
+    shells_ = Shells(P_, scene_.materials, kernel_, by_index);
+    shells_.update(P_);
+  }
   if (!solids_.empty() && contact_.k > 0.0)
     min_contact_mass_ = std::min(min_contact_mass_, solids_.min_mass());
 
@@ -236,6 +249,8 @@ double World::stable_dt() const {
   // Elastic solids: the same condition with the P-wave speed sqrt((lambda + 2 mu) / rho), the fastest signal
   // of the solid.
   if (!solids_.empty()) dt = std::min(dt, scene_.cfl * h / (solids_.max_wave_speed() + max_speed_));
+  // Shells: the plate wave and the shear-rotary limit (Shells::stable_dt).
+  if (!shells_.empty()) dt = std::min(dt, shells_.stable_dt(scene_.cfl, max_speed_));
   // Viscous diffusion limit (Morris, Fox & Zhu 1997, eq. 18): dt <= 0.125 h^2 / nu.
   if (max_nu_ > 0.0) dt = std::min(dt, 0.125 * h * h / max_nu_);
   // Contact spring: two particles of mass m on a spring k touch for about pi sqrt(m / 2k) (m: see the
@@ -327,11 +342,12 @@ void World::step(double dt) {
 
   // Forces on body particles from the fluid and from contact (eqs. 23-25).
   t0 = Clock::now();
-  if (!rigid_.empty() || !solids_.empty()) body_forces();
+  if (!rigid_.empty() || !solids_.empty() || !shells_.empty()) body_forces();
   profile_.rigid += seconds_since(t0);
 
   t0 = Clock::now();
-  if (!solids_.empty()) step_solids();  // eqs. (14)-(18)
+  if (!solids_.empty()) step_solids();    // eqs. (14)-(18)
+  if (!shells_.empty()) step_shells(dt);  // one-layer shells (sim/solid/shell.hpp)
   profile_.solid += seconds_since(t0);
 
   t0 = Clock::now();
@@ -350,6 +366,7 @@ void World::step(double dt) {
   if (!open_.empty() && open_.update(P_, nb_, kernel_, gravity_, time_ + dt, dt)) {
     lists_valid_ = false;
     solids_.reindex(P_);  // particles were appended and removed: the solid's slots follow (by particle id)
+    shells_.reindex(P_);
   }
   profile_.open_boundary += seconds_since(t0);
 
@@ -372,7 +389,7 @@ void World::integrate(double dt) {
   const double kick = kick_length(dt);
   const Periodic& per = ctx_.periodic;
   parallel_for(P_.size(), [&](std::size_t i) {
-    if (P_.kind[i] != Kind::Fluid && P_.kind[i] != Kind::Elastic) return;
+    if (P_.kind[i] != Kind::Fluid && P_.kind[i] != Kind::Elastic && P_.kind[i] != Kind::Shell) return;
     P_.v[i] += kick * P_.a[i];
     P_.x[i] += dt * P_.v[i];
     if (!shift_.empty()) P_.x[i] += shift_[i];
@@ -425,6 +442,67 @@ void World::step_solids() {
 void World::permute(const std::vector<uint32_t>& order) {
   P_.permute(order);
   solids_.reindex(P_);
+  shells_.reindex(P_);
+}
+
+// Shell bodies: seeds (normal, area, support) of the particles first .. first + n of one body, by particle
+// id. Supports: the body's fixed and pinned boxes and the shape's own (a disc's rim); a box that holds no
+// particle of the body is an error naming the key.
+void World::add_shell_seeds(const Body& body, const std::string& where, const ShapeSample& sample,
+                            std::size_t first, std::vector<ShellSeed>& seeds) const {
+  seeds.resize(P_.size());
+  const std::size_t n = sample.points.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    ShellSeed& sd = seeds[first + k];
+    sd.normal = sample.normals[k];
+    sd.area = sample.areas[k];
+    if (!sample.pinned.empty() && sample.pinned[k]) sd.support = 2;
+    if (!sample.clamped.empty() && sample.clamped[k]) sd.support = 1;
+  }
+  auto apply = [&](const std::vector<Box>& boxes, const char* key, uint8_t level) {
+    for (std::size_t b = 0; b < boxes.size(); ++b) {
+      std::size_t held = 0;
+      for (std::size_t k = 0; k < n; ++k)
+        if (boxes[b].contains(sample.points[k])) {
+          ShellSeed& sd = seeds[first + k];
+          if (sd.support == 0 || level == 1) sd.support = level;  // fixed wins over pinned
+          ++held;
+        }
+      if (held == 0)
+        throw SetupError(where + "." + key + (boxes.size() > 1 ? "[" + std::to_string(b) + "]" : "") +
+                         ": the region holds no particle of the body");
+    }
+  };
+  apply(body.shell_pinned, "pinned", 2);
+  apply(body.shell_fixed, "fixed", 1);
+}
+
+// Shells: resultants, internal forces and director moments (Shells::update), plus what body_forces() found,
+// gravity, the body's pressure load p(t) A n along the current normal and the material's damping; then the
+// directors turn (their leapfrog, like integrate() for positions). Supported particles hold their position
+// (and, fixed, their director).
+void World::step_shells(double dt) {
+  shells_.update(P_);
+  shells_.add_forces(force_);
+  std::vector<double> pressure(bodies_.size(), 0.0);
+  for (std::size_t b = 0; b < bodies_.size(); ++b)
+    if (scene_.bodies[b].pressure_load) pressure[b] = scene_.bodies[b].pressure_load->at(time_);
+  parallel_for(shells_.size(), [&](std::size_t s) {
+    const uint32_t i = shells_.at(s);
+    if (shells_.support(s) == 1 || shells_.support(s) == 2) {
+      P_.a[i] = Vec3::Zero();
+      P_.v[i] = Vec3::Zero();
+      return;
+    }
+    const Vec3 f = force_[i] + pressure[P_.body[i]] * shells_.area(s) * shells_.normal(s);
+    P_.a[i] = f / shells_.mass(s) + gravity_ - shells_.damping(s) * P_.v[i];
+    if (shells_.support(s) == 3) {  // a diaphragm (validations): held in the plane across free_axis
+      const Vec3& ax = shells_.free_axis(s);
+      P_.a[i] = P_.a[i].dot(ax) * ax;
+      P_.v[i] = P_.v[i].dot(ax) * ax;
+    }
+  });
+  shells_.advance_directors(dt, kick_length(dt));
 }
 
 // Rigid bodies, eqs. (19)-(22): the per-particle forces of body_forces() summed per body in array order (the
@@ -596,6 +674,11 @@ void World::save_state(StateWriter& out) const {
 
   // The Verlet lists are rebuilt from the positions of their last build (and the rebuild and sort schedule
   // continues from builds_), so the resumed run sees the very lists the saved one had.
+  // Shells: the directors and their spin, by shell slot (the reference is rebuilt from the scene).
+  SectionWriter& sh = out.section("shells", 1);
+  sh.array(shells_.directors());
+  sh.array(shells_.omegas());
+
   SectionWriter& nb = out.section("neighbors", 1);
   nb.value(lists_valid_);
   nb.value(builds_);
@@ -630,7 +713,7 @@ void World::load_state(const StateReader& in) {
   p.done();
   for (std::size_t i = 0; i < n; ++i)
     if (P_.body[i] >= bodies_.size() || P_.material[i] >= scene_.materials.size() ||
-        static_cast<uint8_t>(P_.kind[i]) > static_cast<uint8_t>(Kind::Outflow))
+        static_cast<uint8_t>(P_.kind[i]) > static_cast<uint8_t>(Kind::Shell))
       throw SetupError("checkpoint section 'particles': particle " + std::to_string(i) +
                        " refers to a body or material this scene does not have");
 
@@ -667,6 +750,12 @@ void World::load_state(const StateReader& in) {
         *v = of.value<double>();
     of.done();
   }
+  if (in.has("shells") || !shells_.empty()) {
+    SectionReader sh = in.section("shells");
+    sh.array(shells_.directors(), "shell directors", shells_.size());
+    sh.array(shells_.omegas(), "shell angular velocities", shells_.size());
+    sh.done();
+  }
 
   SectionReader nb = in.section("neighbors");
   lists_valid_ = nb.value<bool>();
@@ -683,6 +772,10 @@ void World::load_state(const StateReader& in) {
   if (!solids_.empty()) {
     solids_.reindex(P_);
     solids_.update_stress(P_);
+  }
+  if (!shells_.empty()) {
+    shells_.reindex(P_);
+    shells_.update(P_);
   }
 }
 
@@ -721,6 +814,8 @@ Snapshot World::snapshot(const std::vector<std::string>& fields, int frame) cons
       f.unit = "Pa";  // von Mises stress of elastic particles; zero elsewhere
       for (std::size_t k = 0; k < solids_.size(); ++k)
         f.values[solids_.at(k)] = static_cast<float>(solids_.von_mises(k));
+      for (std::size_t k = 0; k < shells_.size(); ++k)  // shells: the largest over the Gauss points
+        f.values[shells_.at(k)] = static_cast<float>(shells_.von_mises(k));
     }
   }
   for (std::size_t b = 0; b < bodies_.size(); ++b) {

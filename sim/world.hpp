@@ -13,11 +13,13 @@
 #include "core/neighbors.hpp"
 #include "core/particles.hpp"
 #include "fluid/fluid_wcsph.hpp"
+#include "geometry/shapes.hpp"
 #include "io/checkpoint.hpp"
 #include "io/snapshot.hpp"
 #include "rigid/contact_dem.hpp"
 #include "rigid/rigid_body.hpp"
 #include "scene.hpp"
+#include "solid/shell.hpp"
 #include "solid/solid_tlsph.hpp"
 
 namespace aortasph {
@@ -82,6 +84,8 @@ class World {
       if (P_.body[i] != body || P_.kind[i] == Kind::Wall || P_.kind[i] == Kind::Rigid) continue;
       const long s = solids_.slot(i);
       if (s >= 0 && solids_.clamped(static_cast<std::size_t>(s))) continue;
+      const long sh = shells_.slot(i);
+      if (sh >= 0 && shells_.support(static_cast<std::size_t>(sh)) != 0) continue;
       P_.v[i] = v_of_x0(P_.x0[i]);
       max_speed_ = std::max(max_speed_, P_.v[i].norm());
     }
@@ -125,8 +129,11 @@ class World {
   // (rigid particles' mass lives in their RigidBody).
   double inertial_mass(std::size_t i) const {
     const long s = solids_.slot(i);
+    if (const long sh = shells_.slot(i); sh >= 0) return shells_.mass(static_cast<std::size_t>(sh));
     return s >= 0 ? solids_.mass(static_cast<std::size_t>(s)) : P_.m[i];
   }
+  const Shells& shells() const { return shells_; }
+  Shells& shells_for_test() { return shells_; }
   const CubicSpline& kernel() const { return kernel_; }
   const std::vector<FluidParams>& fluid_params() const { return fluid_; }
   const Profile& profile() const { return profile_; }
@@ -167,6 +174,9 @@ class World {
   void body_forces();
   void step_rigid(double dt);
   void step_solids();
+  void step_shells(double dt);
+  void add_shell_seeds(const Body& body, const std::string& where, const ShapeSample& sample,
+                       std::size_t first, std::vector<ShellSeed>& seeds) const;
   void permute(const std::vector<uint32_t>& order);
   void check_and_remove(double dt);
 
@@ -181,6 +191,7 @@ class World {
   std::vector<BodyInfo> bodies_;
   std::vector<RigidBody> rigid_;
   Solids solids_;
+  Shells shells_;
   OpenBoundaries open_;  // inflows and outflows; their counters are plain values (OpenBoundaryState)
   ContactParams contact_;
   double min_contact_mass_ = std::numeric_limits<double>::max();

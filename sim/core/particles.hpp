@@ -14,7 +14,8 @@ namespace aortasph {
 // Inflow and Outflow: fluid particles in the buffer of an open boundary (sim/boundary/open_boundary.hpp).
 // They enter the fluid's sums like fluid particles, but their velocity, density and pressure are imposed or
 // extrapolated by the open boundary instead of being integrated.
-enum class Kind : uint8_t { Fluid = 0, Wall = 1, Rigid = 2, Elastic = 3, Inflow = 4, Outflow = 5 };
+// Shell: a particle of a one-layer shell's mid-surface (sim/solid/shell.hpp).
+enum class Kind : uint8_t { Fluid = 0, Wall = 1, Rigid = 2, Elastic = 3, Inflow = 4, Outflow = 5, Shell = 6 };
 
 // Particles that the fluid sees as fluid: fluid proper and open-boundary buffer particles.
 inline bool fluid_like(Kind k) {

@@ -81,6 +81,102 @@ void cylinder_mesh(const Vec3& base, const Vec3& a, double r, double L, bool inw
   }
 }
 
+// In-plane axes (u, v) of a rectangle: u along u_axis projected into the plane (or the perpendicular_frame's
+// first axis), v = n x u.
+void rectangle_axes(const Shape& s, Vec3& u, Vec3& v) {
+  const Vec3 n = s.normal.normalized();
+  if (s.u_axis) {
+    u = (*s.u_axis - s.u_axis->dot(n) * n).normalized();
+  } else {
+    Vec3 w;
+    frame(n, u, w);
+  }
+  v = n.cross(u);
+}
+
+// One layer of particles on a shell's mid-surface at spacing dx, with normals and areas.
+//   rectangle: (i + 1/2) dx from one corner along u and v, round(size / dx) per side, area dx^2;
+//   disc: the centre and rings at radius k dr (dr = radius / round(radius / dx)) of round(2 pi k) particles,
+//     each the area of its ring's annulus (half an annulus for the rim at exactly `radius`), so the rim lies
+//     on the circle (where a clamped plate's boundary is);
+//   cylindrical_panel: (i + 1/2) steps along the axis and along the arc (round(length / dx),
+//     round(radius angle / dx)), area (length / n_axis) (radius angle / n_arc).
+void sample_shell(const Shape& s, double dx, ShapeSample& out) {
+  const Vec3 n = s.normal.normalized();
+  auto add = [&](const Vec3& p, const Vec3& nrm, double area) {
+    out.points.push_back(p);
+    out.normals.push_back(nrm);
+    out.areas.push_back(area);
+  };
+  if (s.kind == ShapeKind::Rectangle) {
+    Vec3 u, v;
+    rectangle_axes(s, u, v);
+    const int na = static_cast<int>(std::lround(s.size[0] / dx)),
+              nb = static_cast<int>(std::lround(s.size[1] / dx));
+    for (int j = 0; j < nb; ++j)
+      for (int i = 0; i < na; ++i)
+        add(s.center + ((i + 0.5) * dx - 0.5 * na * dx) * u + ((j + 0.5) * dx - 0.5 * nb * dx) * v, n,
+            dx * dx);
+    const Vec3 a = 0.5 * na * dx * u, b = 0.5 * nb * dx * v;
+    add_quad(out.mesh, s.center - a - b, s.center + a - b, s.center + a + b, s.center - a + b);
+  } else if (s.kind == ShapeKind::Disc) {
+    Vec3 u, v;
+    frame(n, u, v);
+    const int rings = static_cast<int>(std::lround(s.radius / dx));
+    if (rings < 1) return;
+    const double dr = s.radius / rings;
+    add(s.center, n, std::numbers::pi * 0.25 * dr * dr);
+    for (int k = 1; k <= rings; ++k) {
+      const double r = k * dr;
+      const int m = static_cast<int>(std::lround(2.0 * std::numbers::pi * k));
+      const double outer = k == rings ? r : r + 0.5 * dr, inner = r - 0.5 * dr;
+      const double area = std::numbers::pi * (outer * outer - inner * inner) / m;
+      const double phase = (k % 2) * std::numbers::pi / m;  // stagger neighbouring rings
+      for (int q = 0; q < m; ++q) {
+        const double th = phase + 2.0 * std::numbers::pi * q / m;
+        add(s.center + r * (std::cos(th) * u + std::sin(th) * v), n, area);
+        if (k == rings) {
+          out.clamped.resize(out.points.size(), 0);
+          out.pinned.resize(out.points.size(), 0);
+          out.clamped.back() = s.rim == 1;
+          out.pinned.back() = s.rim == 2;
+        }
+      }
+    }
+    out.clamped.resize(out.points.size(), 0);
+    out.pinned.resize(out.points.size(), 0);
+    const int seg = 48;
+    for (int q = 0; q < seg; ++q) {
+      const double t0 = 2 * std::numbers::pi * q / seg, t1 = 2 * std::numbers::pi * (q + 1) / seg;
+      add_quad(out.mesh, s.center, s.center + s.radius * (std::cos(t0) * u + std::sin(t0) * v),
+               s.center + s.radius * (std::cos(t1) * u + std::sin(t1) * v), s.center);
+    }
+  } else {
+    const Vec3 a = s.axis.normalized();
+    const Vec3 crown = (n - n.dot(a) * a).normalized();
+    const Vec3 side = a.cross(crown);
+    const double half = 0.5 * s.angle * std::numbers::pi / 180.0;
+    const int nl = static_cast<int>(std::lround(s.length / dx));
+    const int nt = static_cast<int>(std::lround(s.radius * 2.0 * half / dx));
+    if (nl < 1 || nt < 1) return;
+    const double dl = s.length / nl, dth = 2.0 * half / nt;
+    auto radial = [&](double th) { return Vec3(std::cos(th) * crown + std::sin(th) * side); };
+    for (int j = 0; j < nt; ++j)
+      for (int i = 0; i < nl; ++i) {
+        const double th = -half + (j + 0.5) * dth;
+        add(s.center + (-0.5 * s.length + (i + 0.5) * dl) * a + s.radius * radial(th), radial(th),
+            dl * s.radius * dth);
+      }
+    const int seg = std::max(4, nt);
+    for (int j = 0; j < seg; ++j) {
+      const double t0 = -half + 2.0 * half * j / seg, t1 = -half + 2.0 * half * (j + 1) / seg;
+      const Vec3 p0 = s.center + s.radius * radial(t0), p1 = s.center + s.radius * radial(t1);
+      const Vec3 e = 0.5 * s.length * a;
+      add_quad(out.mesh, p0 - e, p1 - e, p1 + e, p0 + e);
+    }
+  }
+}
+
 }  // namespace
 
 void perpendicular_frame(const Vec3& axis, Vec3& u, Vec3& v) {
@@ -99,6 +195,10 @@ Vec3 shape_center(const Shape& s) {
       return s.base + 0.5 * s.length * s.axis.normalized();
     case ShapeKind::AorticRoot:
       return s.aortic.base;  // the same for every part of one root, so they rotate together
+    case ShapeKind::Rectangle:
+    case ShapeKind::Disc:
+    case ShapeKind::CylindricalPanel:
+      return s.center;
     default:
       return Vec3::Zero();
   }
@@ -195,6 +295,11 @@ ShapeSample sample_body(const Body& body, double dx) {
       break;
     case ShapeKind::Mesh:
       break;  // refused by the scene loader until implemented
+    case ShapeKind::Rectangle:
+    case ShapeKind::Disc:
+    case ShapeKind::CylindricalPanel:
+      sample_shell(s, dx, out);
+      break;
   }
 
   // Rotation about the shape's centre, then translation.
@@ -204,6 +309,7 @@ ShapeSample sample_body(const Body& body, double dx) {
         Eigen::AngleAxisd(body.rotate_degrees * std::numbers::pi / 180.0, body.rotate_axis.normalized())
             .toRotationMatrix();
     for (Vec3& p : out.points) p = c + R * (p - c) + body.translate;
+    for (Vec3& nrm : out.normals) nrm = R * nrm;
     for (auto& vtx : out.mesh.vertices) {
       const Vec3 p = c + R * (Vec3(vtx[0], vtx[1], vtx[2]) - c) + body.translate;
       vtx = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};

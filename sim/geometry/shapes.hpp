@@ -16,7 +16,17 @@ struct ShapeSample {
   // Empty, or one flag per point: 1 = clamped by the shape itself (the aortic leaflets' rows along their
   // attachment to the wall). Elastic solvers treat these like the body's `fixed` region.
   std::vector<uint8_t> clamped;
+  // Shell shapes (rectangle, disc, cylindrical_panel): per point the unit normal of the mid-surface and the
+  // area the particle stands for; pinned like clamped, position only (a disc's pinned rim).
+  std::vector<Vec3> normals;
+  std::vector<double> areas;
+  std::vector<uint8_t> pinned;
 };
+
+// Whether a shape is a shell's mid-surface (one layer of particles).
+inline bool is_shell_shape(ShapeKind k) {
+  return k == ShapeKind::Rectangle || k == ShapeKind::Disc || k == ShapeKind::CylindricalPanel;
+}
 
 // Lattice convention: a box [min, max] holds the centres min + (i + 1/2) dx, so the particles' cubes tile it
 // exactly. Curved shapes keep the lattice points inside them. Container and tube walls lie outside their

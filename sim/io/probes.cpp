@@ -242,6 +242,24 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
         for (const std::string& c : coaptation_columns(pr.bodies.size()))
           columns_.push_back(pr.name + "." + c);
         break;
+      case ProbeType::Displacement: {
+        // The body particle nearest the point at t = 0 (lowest id on ties), like `point`.
+        add_columns(columns_, pr.name, {"ux", "uy", "uz"});
+        double best = std::numeric_limits<double>::max();
+        bool found = false;
+        for (std::size_t i = 0; i < P.size(); ++i) {
+          if (P.body[i] != pr.body) continue;
+          const double d = (P.x0[i] - pr.point).squaredNorm();
+          if (d < best || (d == best && P.id[i] < tracked_id_[k])) {
+            best = d;
+            tracked_id_[k] = P.id[i];
+            found = true;
+          }
+        }
+        if (!found)
+          throw SetupError("probes[" + std::to_string(k) + "] '" + pr.name + "': body has no particle");
+        break;
+      }
     }
   }
 }
@@ -352,7 +370,9 @@ std::vector<double> ProbeSet::measure(const World& world) const {
           pot -= b.mass * g.dot(b.com);
         }
         // Elastic solids: sum_s V_s psi(E_s), eqs. (15)-(16), plus the hourglass springs' energy.
-        const double elastic = world.solids().elastic_energy(P);
+        // Shells: elastic and hourglass energy of the last update, plus the directors' spin energy.
+        const double elastic = world.solids().elastic_energy(P) + world.shells().energy();
+        kin += world.shells().rotational_energy();
         out.insert(out.end(), {kin, pot, elastic, kin + pot + elastic});
         break;
       }
@@ -446,8 +466,22 @@ std::vector<double> ProbeSet::measure(const World& world) const {
             [](const MS& a, const MS& b) {
               return MS{std::max(a.max, b.max), a.sum + b.sum, a.count + b.count};
             });
+        // Shells: the largest von Mises stress over a particle's Gauss points (sim/solid/shell.hpp).
+        const Shells& Sh = world.shells();
+        const MS rs = parallel_reduce(
+            Sh.size(), MS{},
+            [&](std::size_t s) {
+              if (!in_set[P.body[Sh.at(s)]]) return MS{};
+              const double vm = Sh.von_mises(s);
+              return MS{vm, vm, 1.0};
+            },
+            [](const MS& a, const MS& b) {
+              return MS{std::max(a.max, b.max), a.sum + b.sum, a.count + b.count};
+            });
+        const MS all{std::max(r.max, rs.max), r.sum + rs.sum, r.count + rs.count};
         // The 95th percentile (nearest rank) of the gathered values and the largest principal Green-Lagrange
-        // strain (eq. 15): gathered in array order, so the same for any thread count.
+        // strain (eq. 15; volumetric solids only, shells not yet): gathered in array order, so the same for
+        // any thread count.
         std::vector<double> vm;
         double strain = 0.0;
         for (std::size_t s = 0; s < S.size(); ++s)
@@ -455,8 +489,10 @@ std::vector<double> ProbeSet::measure(const World& world) const {
             vm.push_back(S.von_mises(s));
             strain = std::max(strain, largest_principal_strain(S.F(s)));
           }
-        out.insert(out.end(),
-                   {r.max, r.count > 0 ? r.sum / r.count : 0.0, percentile_nearest_rank(vm, 95.0), strain});
+        for (std::size_t s = 0; s < Sh.size(); ++s)
+          if (in_set[P.body[Sh.at(s)]]) vm.push_back(Sh.von_mises(s));
+        out.insert(out.end(), {all.max, all.count > 0 ? all.sum / all.count : 0.0,
+                               percentile_nearest_rank(vm, 95.0), strain});
         break;
       }
       case ProbeType::MaxSpeed: {
@@ -479,6 +515,14 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const CoaptationStats c = coaptation(world, pr);
         for (std::size_t k = 0; k < c.height.size(); ++k) out.insert(out.end(), {c.height[k], c.length[k]});
         out.insert(out.end(), {c.central_height, c.effective_height});
+        break;
+      }
+      case ProbeType::Displacement: {
+        std::size_t at = n;
+        for (std::size_t i = 0; i < n && at == n; ++i)
+          if (P.id[i] == tracked_id_[k]) at = i;
+        const Vec3 u = at == n ? Vec3::Constant(kNaN) : Vec3(P.x[at] - P.x0[at]);
+        for (int d = 0; d < 3; ++d) out.push_back(u[d]);
         break;
       }
       case ProbeType::Gap: {

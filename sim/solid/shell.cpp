@@ -1,0 +1,364 @@
+#include "solid/shell.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include "core/neighbors.hpp"
+#include "core/parallel.hpp"
+#include "core/sim_errors.hpp"
+#include "geometry/shapes.hpp"
+
+namespace aortasph {
+
+namespace {
+
+// Gauss-Legendre rules on [-1, 1] through the thickness (zeta = t/2 xi): 2 points for Saint Venant-Kirchhoff
+// (exact for its energy, quadratic in zeta at small strain), 3 for neo-Hookean. Slot 0 is the mid-surface
+// (xi = 0) in both, for J0 at zeta = 0; the 2-point rule gives it weight 0.
+constexpr double kXi2[3] = {0.0, -0.5773502691896258, 0.5773502691896258};
+constexpr double kW2[3] = {0.0, 1.0, 1.0};
+constexpr double kXi3[3] = {0.0, -0.7745966692414834, 0.7745966692414834};
+constexpr double kW3[3] = {8.0 / 9.0, 5.0 / 9.0, 5.0 / 9.0};
+
+Mat3 columns(const Shells::Mat32& A, const Vec3& c) {
+  Mat3 J;
+  J.leftCols<2>() = A;
+  J.col(2) = c;
+  return J;
+}
+
+double von_mises_plane(const Mat3& S) {
+  const double a = S(0, 0), b = S(1, 1), c = S(0, 1);
+  return std::sqrt(a * a - a * b + b * b + 3.0 * (c * c + S(0, 2) * S(0, 2) + S(1, 2) * S(1, 2)));
+}
+
+}  // namespace
+
+Shells::Shells(const Particles& P, const std::vector<Material>& materials, const CubicSpline& kernel,
+               const std::vector<ShellSeed>& seed)
+    : h_(kernel.h) {
+  params_.resize(materials.size());
+  for (std::size_t m = 0; m < materials.size(); ++m)
+    if (materials[m].type == MaterialType::Shell) params_[m] = ShellParams(materials[m]);
+  uint32_t max_id = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) max_id = std::max(max_id, P.id[i]);
+  s_of_id_.assign(P.size() == 0 ? 0 : max_id + 1, kNone);
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.kind[i] != Kind::Shell) continue;
+    const ShellParams& sp = params_[P.material[i]];
+    s_of_id_[P.id[i]] = static_cast<uint32_t>(id_.size());
+    id_.push_back(P.id[i]);
+    X_.push_back(P.x0[i]);
+    const Vec3 n = seed[i].normal.normalized();
+    N_.push_back(n);
+    Vec3 u, v;
+    perpendicular_frame(n, u, v);  // (u, v, n) orthonormal, right-handed
+    T1_.push_back(u);
+    T2_.push_back(v);
+    area_.push_back(seed[i].area);
+    mass_.push_back(sp.rho0 * sp.t * seed[i].area);
+    inertia_.push_back(sp.rho0 * sp.t * sp.t * sp.t / 12.0 * seed[i].area);
+    material_.push_back(P.material[i]);
+    support_.push_back(seed[i].support);
+  }
+  const std::size_t n = X_.size();
+  d_ = N_;
+  omega_.assign(n, Vec3::Zero());
+  reindex(P);
+  if (n == 0) return;
+
+  // Reference neighbours within the kernel support, of one body.
+  NeighborSearch nb;
+  nb.build(X_, kernel.support);
+  std::vector<uint16_t> body(n);
+  for (std::size_t s = 0; s < n; ++s) body[s] = P.body[at_[s]];
+  offset_.assign(n + 1, 0);
+  for (std::size_t s = 0; s < n; ++s) {
+    uint32_t count = 0;
+    for (uint32_t k = nb.begin(s); k < nb.end(s); ++k) {
+      const uint32_t t = nb.index()[k];
+      count += t != s && body[t] == body[s];
+    }
+    offset_[s + 1] = offset_[s] + count;
+  }
+  nbr_.resize(offset_[n]);
+  for (std::size_t s = 0; s < n; ++s) {
+    uint32_t out = offset_[s];
+    for (uint32_t k = nb.begin(s); k < nb.end(s); ++k)
+      if (const uint32_t t = nb.index()[k]; t != s && body[t] == body[s]) nbr_[out++] = t;
+  }
+  rev_.resize(nbr_.size());
+  parallel_for(n, [&](std::size_t s) {
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const uint32_t t = nbr_[k];
+      rev_[k] = kNone;
+      for (uint32_t l = offset_[t]; l < offset_[t + 1]; ++l)
+        if (nbr_[l] == s) rev_[k] = l;
+    }
+  });
+
+  // In-plane corrected gradient weights (Wu et al. 2023, the reduced correction matrix): in s's tangent
+  // frame, a_st = (T1.X_st, T2.X_st), h_st = W'(r) a_st / r, g_st = L_s h_st with L_s = (sum_t A_t h_st
+  // a_st^T)^-1, so that sum_t A_t (f_t - f_s) g_st^T is exact for every field linear in the tangent plane.
+  g_.resize(nbr_.size());
+  std::vector<double> ksum(n, 0.0);
+  parallel_for(n, [&](std::size_t s) {
+    Mat2 M = Mat2::Zero();
+    std::vector<Eigen::Vector2d> hv(offset_[s + 1] - offset_[s]);
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const Vec3 X = X_[nbr_[k]] - X_[s];
+      const double r = X.norm();
+      const Eigen::Vector2d a(T1_[s].dot(X), T2_[s].dot(X));
+      const Eigen::Vector2d hh = (kernel.dWdr(r) / r) * a;
+      hv[k - offset_[s]] = hh;
+      M += area_[nbr_[k]] * hh * a.transpose();
+      ksum[s] += area_[nbr_[k]] * kernel.W(r);
+    }
+    const Mat2 L = std::abs(M.determinant()) > 1e-12 * M.squaredNorm() ? Mat2(M.inverse()) : Mat2::Zero();
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) g_[k] = L * hv[k - offset_[s]];
+  });
+
+  // Reference mid-surface tangents G0, director gradient H0 and, per Gauss point, J0^-1 and the volume.
+  K0_.resize(kGauss * n);
+  vol_.resize(kGauss * n);
+  b_.resize(nbr_.size());
+  k_hg_.resize(nbr_.size());
+  parallel_for(n, [&](std::size_t s) {
+    const ShellParams& sp = params_[material_[s]];
+    Mat32 G0 = Mat32::Zero(), H0 = Mat32::Zero();
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const uint32_t t = nbr_[k];
+      G0 += area_[t] * (X_[t] - X_[s]) * g_[k].transpose();
+      H0 += area_[t] * (N_[t] - N_[s]) * g_[k].transpose();
+    }
+    if (offset_[s] == offset_[s + 1]) G0 << T1_[s], T2_[s];
+    const double det0 = columns(G0, N_[s]).determinant();
+    const double* xi = sp.neo_hookean ? kXi3 : kXi2;
+    const double* wq = sp.neo_hookean ? kW3 : kW2;
+    for (int q = 0; q < kGauss; ++q) {
+      const double zeta = 0.5 * sp.t * xi[q];
+      const Mat3 J0 = columns(G0 + zeta * H0, N_[s]);
+      const double det = J0.determinant();
+      K0_[kGauss * s + q] = std::abs(det) > 1e-12 ? Mat3(J0.inverse()) : Mat3::Identity();
+      vol_[kGauss * s + q] = area_[s] * wq[q] * 0.5 * sp.t * (std::abs(det0) > 1e-12 ? det / det0 : 1.0);
+    }
+    const Mat3& K = K0_[kGauss * s];
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const uint32_t t = nbr_[k];
+      const Vec3 X = X_[t] - X_[s];
+      b_[k] = K * X;
+      // Hourglass stiffness: alpha E t / (1 - nu^2) A_s A_t W / (|X|^2 Wbar), Wbar the mean kernel sum of
+      // the pair, so that sum_t k |eps|^2 ~ alpha (E t) A |grad eps|^2: the membrane stiffness' scale.
+      const double wbar = 0.5 * (ksum[s] + ksum[t]);
+      k_hg_[k] = sp.hourglass * sp.E * sp.t / (1.0 - sp.nu * sp.nu) * area_[s] * area_[t] *
+                 kernel.W(X.norm()) / (X.squaredNorm() * std::max(wbar, 1e-300));
+    }
+  });
+
+  x_.resize(n);
+  G_.assign(n, Mat32::Zero());
+  H_.assign(n, Mat32::Zero());
+  PG_.assign(n, Mat32::Zero());
+  PH_.assign(n, Mat32::Zero());
+  q_.assign(n, Vec3::Zero());
+  hg_force_.assign(n, Vec3::Zero());
+  force_.assign(n, Vec3::Zero());
+  torque_.assign(n, Vec3::Zero());
+  F0_.assign(n, Mat3::Identity());
+  energy_.assign(n, 0.0);
+  vm_.assign(n, 0.0);
+  Nres_.assign(n, Mat2::Zero());
+  Mres_.assign(n, Mat2::Zero());
+  Qres_.assign(n, Eigen::Vector2d::Zero());
+}
+
+void Shells::reindex(const Particles& P) {
+  at_.assign(X_.size(), kNone);
+  slot_.assign(P.size(), kNone);
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.kind[i] != Kind::Shell || P.id[i] >= s_of_id_.size()) continue;
+    const uint32_t s = s_of_id_[P.id[i]];
+    if (s == kNone) continue;
+    at_[s] = static_cast<uint32_t>(i);
+    slot_[i] = s;
+  }
+  for (std::size_t s = 0; s < X_.size(); ++s)
+    if (at_[s] == kNone) {
+      std::ostringstream msg;
+      msg << "shell particle " << id_[s] << " (reference position " << X_[s].transpose()
+          << ") left the domain: its body cannot hold together without it";
+      throw InstabilityError(msg.str());
+    }
+}
+
+Vec3 Shells::normal(std::size_t s) const {
+  const Vec3 n = G_[s].col(0).cross(G_[s].col(1));
+  const double len = n.norm();
+  return len > 0.0 ? Vec3(n / len) : d_[s];
+}
+
+void Shells::update(const Particles& P) {
+  const std::size_t n = X_.size();
+  parallel_for(n, [&](std::size_t s) { x_[s] = P.x[at_[s]]; });
+  // Mid-surface tangents and director gradient.
+  parallel_for(n, [&](std::size_t s) {
+    Mat32 G = Mat32::Zero(), H = Mat32::Zero();
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const uint32_t t = nbr_[k];
+      G += area_[t] * (x_[t] - x_[s]) * g_[k].transpose();
+      H += area_[t] * (d_[t] - d_[s]) * g_[k].transpose();
+    }
+    if (offset_[s] == offset_[s + 1]) G << T1_[s], T2_[s];
+    G_[s] = G;
+    H_[s] = H;
+    F0_[s] = columns(G, d_[s]) * K0_[kGauss * s];
+  });
+  // Stress at the Gauss points, resultants and the energy's derivatives by G, H and d.
+  parallel_for(n, [&](std::size_t s) {
+    const ShellParams& sp = params_[material_[s]];
+    Mat3 Q0;
+    Q0 << T1_[s], T2_[s], N_[s];
+    Mat32 PG = Mat32::Zero(), PH = Mat32::Zero();
+    Vec3 q = Vec3::Zero();
+    double U = 0.0, vm = 0.0;
+    Mat2 Nr = Mat2::Zero(), Mr = Mat2::Zero();
+    Eigen::Vector2d Qr = Eigen::Vector2d::Zero();
+    const double* xi = sp.neo_hookean ? kXi3 : kXi2;
+    for (int k = sp.neo_hookean ? 0 : 1; k < kGauss; ++k) {
+      const double zeta = 0.5 * sp.t * xi[k];
+      const Mat3& K = K0_[kGauss * s + k];
+      const Mat3 F = columns(G_[s] + zeta * H_[s], d_[s]) * K;
+      const Mat3 Eg = 0.5 * (F.transpose() * F - Mat3::Identity());
+      const Mat3 El = Q0.transpose() * Eg * Q0;
+      Mat3 Sl;
+      double psi = 0.0;
+      shell_stress(sp, El, Sl, psi);
+      const double V = vol_[kGauss * s + k];
+      U += V * psi;
+      vm = std::max(vm, von_mises_plane(Sl));
+      // Resultants per unit length: the through-thickness integrals of S (sum of w_k t/2 S).
+      const double wt = V / area_[s];
+      Nr += wt * Sl.topLeftCorner<2, 2>();
+      Mr += wt * zeta * Sl.topLeftCorner<2, 2>();
+      Qr += wt * Sl.block<2, 1>(0, 2);
+      // dpsi/dF = F S (first Piola-Kirchhoff), dpsi/dJ = P K^T with J = [G + zeta H | d].
+      const Mat3 Pk = F * (Q0 * Sl * Q0.transpose());
+      const Mat3 dJ = V * Pk * K.transpose();
+      PG += dJ.leftCols<2>();
+      PH += zeta * dJ.leftCols<2>();
+      q += dJ.col(2);
+    }
+    PG_[s] = PG;
+    PH_[s] = PH;
+    q_[s] = q;
+    energy_[s] = U;
+    vm_[s] = vm;
+    Nres_[s] = Nr;
+    Mres_[s] = Mr;
+    Qres_[s] = Qr;
+  });
+  // Hourglass energy: per pair eps = (F_s + F_t) X / 2 - x_st, U = 1/2 k |eps|^2 (each pair seen from both
+  // ends, half the energy each). Its derivative by G_s, d_s goes into PG, q; the pair term into hg_force_.
+  parallel_for(n, [&](std::size_t s) {
+    const ShellParams& sp = params_[material_[s]];
+    if (sp.hourglass <= 0.0) {
+      hg_force_[s] = Vec3::Zero();
+      return;
+    }
+    Vec3 fp = Vec3::Zero();
+    Mat32 PG = Mat32::Zero();
+    Vec3 q = Vec3::Zero();
+    double U = 0.0;
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const uint32_t t = nbr_[k];
+      const Vec3 X = X_[t] - X_[s];
+      const Vec3 eps = 0.5 * (F0_[s] + F0_[t]) * X - (x_[t] - x_[s]);
+      const double kk = k_hg_[k];
+      U += 0.25 * kk * eps.squaredNorm();
+      // d eps / d G_s = 1/2 (.) b_s^T with b_s = K0_s X (first two entries), d eps / d d_s = 1/2 b_s(2).
+      PG += 0.5 * kk * eps * b_[k].head<2>().transpose();
+      q += 0.5 * kk * b_[k](2) * eps;
+      fp -= kk * eps;  // d eps / d x_s = +I
+    }
+    PG_[s] += PG;
+    q_[s] += q;
+    energy_[s] += U;
+    hg_force_[s] = fp;
+  });
+  // Forces and director moments (gather): f_s = -dU/dx_s, gamma_s = -dU/dd_s, with G_t = sum_u A_u (x_u -
+  // x_t) g_tu^T contributing A_s PG_t g_ts to dU/dx_s and -sum_u A_u PG_s g_su.
+  parallel_for(n, [&](std::size_t s) {
+    Vec3 f = hg_force_[s];
+    Vec3 gam = -q_[s];
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const uint32_t t = nbr_[k];
+      const Eigen::Vector2d& gst = g_[k];
+      const Eigen::Vector2d& gts = g_[rev_[k]];
+      f += area_[t] * PG_[s] * gst - area_[s] * PG_[t] * gts;
+      gam += area_[t] * PH_[s] * gst - area_[s] * PH_[t] * gts;
+    }
+    force_[s] = f;
+    torque_[s] = d_[s].cross(gam);
+  });
+}
+
+void Shells::add_forces(std::vector<Vec3>& f) const {
+  parallel_for(X_.size(), [&](std::size_t s) { f[at_[s]] += force_[s]; });
+}
+
+void Shells::advance_directors(double dt, double kick) {
+  parallel_for(X_.size(), [&](std::size_t s) {
+    if (support_[s] == 1) {
+      omega_[s] = Vec3::Zero();
+      d_[s] = N_[s];
+      return;
+    }
+    const double c = params_[material_[s]].damping;
+    const Vec3 tau = external_.empty() ? torque_[s] : Vec3(torque_[s] + external_[s]);
+    Vec3 w = omega_[s] + kick * (tau / inertia_[s] - c * omega_[s]);
+    w -= w.dot(d_[s]) * d_[s];  // no spin about the director (it has no inertia, nothing to turn)
+    omega_[s] = w;
+    const double angle = w.norm() * dt;
+    if (angle > 0.0) {
+      const Vec3 axis = w.normalized();
+      const Vec3& d = d_[s];
+      // Rodrigues' rotation of d about axis by angle.
+      const Vec3 r = d * std::cos(angle) + axis.cross(d) * std::sin(angle) +
+                     axis * axis.dot(d) * (1.0 - std::cos(angle));
+      d_[s] = r.normalized();
+    }
+  });
+}
+
+double Shells::stable_dt(double cfl, double max_speed) const {
+  double dt = std::numeric_limits<double>::max();
+  for (std::size_t m = 0; m < params_.size(); ++m) {
+    const ShellParams& p = params_[m];
+    if (p.t <= 0.0) continue;
+    const double h = h_;
+    // Wu et al. 2023 / SPHinXsys ShellAcousticTimeStepSize: the in-plane wave crossing h, and the shear-
+    // rotary (Mindlin) limit, which goes like t / c for h >> t.
+    const double pi2 = std::numbers::pi * std::numbers::pi;
+    const double rotary =
+        h * std::sqrt(1.0 / (p.c_plate * p.c_plate) /
+                      (2.0 + pi2 / 12.0 * (1.0 - p.nu) * (1.0 + 1.5 * (h / p.t) * (h / p.t))));
+    dt = std::min(dt, cfl * std::min(h / (p.c_plate + max_speed), rotary));
+  }
+  return dt;
+}
+
+double Shells::energy() const {
+  return parallel_reduce(
+      X_.size(), 0.0, [&](std::size_t s) { return energy_[s]; }, [](double a, double b) { return a + b; });
+}
+
+double Shells::rotational_energy() const {
+  return parallel_reduce(
+      X_.size(), 0.0, [&](std::size_t s) { return 0.5 * inertia_[s] * omega_[s].squaredNorm(); },
+      [](double a, double b) { return a + b; });
+}
+
+}  // namespace aortasph

@@ -1,0 +1,44 @@
+#include "solid/shell_material.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace aortasph {
+
+ShellParams::ShellParams(const Material& m)
+    : rho0(m.density),
+      E(m.youngs_modulus),
+      nu(m.neo_hookean ? 0.5 : m.poisson_ratio),
+      t(m.thickness),
+      mu(m.neo_hookean ? m.youngs_modulus / 3.0 : m.youngs_modulus / (2.0 * (1.0 + m.poisson_ratio))),
+      lam_ps(m.neo_hookean ? 2.0 * m.youngs_modulus / 3.0
+                           : m.youngs_modulus * m.poisson_ratio / (1.0 - m.poisson_ratio * m.poisson_ratio)),
+      c_plate(std::sqrt(m.youngs_modulus / (m.density * (1.0 - nu * nu)))),
+      damping(m.shell_damping),
+      hourglass(m.hourglass),
+      neo_hookean(m.neo_hookean) {}
+
+void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi) {
+  S.setZero();
+  const double ks = p.kappa * 2.0 * p.mu;  // transverse shear, S_a3 = kappa 2 mu E_a3
+  S(0, 2) = S(2, 0) = ks * E(0, 2);
+  S(1, 2) = S(2, 1) = ks * E(1, 2);
+  psi = ks * (E(0, 2) * E(0, 2) + E(1, 2) * E(1, 2));
+  if (!p.neo_hookean) {
+    const double tr = E(0, 0) + E(1, 1);
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) S(a, b) = 2.0 * p.mu * E(a, b) + (a == b ? p.lam_ps * tr : 0.0);
+    psi +=
+        0.5 * p.lam_ps * tr * tr + p.mu * (E(0, 0) * E(0, 0) + E(1, 1) * E(1, 1) + 2.0 * E(0, 1) * E(0, 1));
+    return;
+  }
+  // Incompressible neo-Hookean, plane stress: lambda3^2 = 1 / det C2.
+  Eigen::Matrix2d C = Eigen::Matrix2d::Identity() + 2.0 * E.topLeftCorner<2, 2>();
+  const double det = std::max(C.determinant(), 1e-6);
+  const Eigen::Matrix2d Cinv = C.inverse();
+  const Eigen::Matrix2d S2 = p.mu * (Eigen::Matrix2d::Identity() - Cinv / det);
+  S.topLeftCorner<2, 2>() = S2;
+  psi += 0.5 * p.mu * (C.trace() + 1.0 / det - 3.0);
+}
+
+}  // namespace aortasph

@@ -1,0 +1,40 @@
+// Plane-stress constitutive laws of the shell (sim/solid/shell.hpp), at one Gauss point through the
+// thickness, in the particle's local frame (T1, T2, N): E is the Green-Lagrange strain, S the second
+// Piola-Kirchhoff stress, psi the energy per reference volume. S33 = 0 (plane stress): the normal strain E33
+// is not an unknown of the kinematics (the director is unit) but follows from S33 = 0 and is eliminated.
+//   - Saint Venant-Kirchhoff in plane stress (the SPHinXsys shell's law; e.g. Bathe, "Finite Element
+//     Procedures", 1996, eq. 6.41 with the Green strain): S_ab = E / (1 - nu^2) ((1 - nu) E_ab + nu E_cc
+//     delta_ab), a, b in-plane; transverse shear S_a3 = kappa 2 G E_a3, kappa = 5/6 (Reissner 1945).
+//   - Incompressible neo-Hookean in plane stress (Holzapfel, "Nonlinear Solid Mechanics", 2000, sect. 6.5,
+//     the membrane form): lambda3^2 = 1 / det C2 with C2 the in-plane 2x2 block of C = I + 2E; psi = mu/2
+//     (tr C2 + 1 / det C2 - 3), S_ab = mu (delta_ab - C2^-1_ab / det C2); mu = E / 3 (the small-strain
+//     Young's modulus is E); transverse shear as above, linear in E_a3 with kappa 2 mu.
+#pragma once
+
+#include <Eigen/Dense>
+
+#include "scene.hpp"
+
+namespace aortasph {
+
+using Mat3 = Eigen::Matrix3d;
+
+struct ShellParams {
+  double rho0 = 1000.0;
+  double E = 0.0, nu = 0.0;
+  double t = 0.0;       // thickness [m]
+  double mu = 0.0;      // shear modulus [Pa]
+  double lam_ps = 0.0;  // plane-stress lambda, E nu / (1 - nu^2)
+  double kappa = 5.0 / 6.0;
+  double c_plate = 0.0;  // plate (in-plane) wave speed sqrt(E / (rho0 (1 - nu^2))) [m/s]
+  double damping = 0.0;  // [1/s]
+  double hourglass = 0.0;
+  bool neo_hookean = false;
+  ShellParams() = default;
+  explicit ShellParams(const Material& m);
+};
+
+// S (local frame, symmetric, S33 = 0) and psi for a local Green-Lagrange strain E (E33 ignored).
+void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi);
+
+}  // namespace aortasph
