@@ -161,7 +161,7 @@ TEST_CASE("cli: an unstable run exits 3, names time and particle, keeps the rows
   CHECK(slurp(dir / "out" / "run.json").find("unstable") != std::string::npos);
 }
 
-TEST_CASE("cli: check prints bodies, counts, h, dt and cost; --help and --version", "[cli]") {
+TEST_CASE("cli: check prints bodies, counts, h, dt and cost, --help and --version", "[cli]") {
   const Result r = aortasph("check " + scene_path("dam_break.json"));
   CHECK(r.code == 0);
   CHECK(aortasph("--help").code == 0);

@@ -88,7 +88,7 @@ std::string slurp(const fs::path& p) {
 
 }  // namespace
 
-TEST_CASE("pipeline: simulation and render threads; flush, colour range and resumed frames", "[pipeline]") {
+TEST_CASE("pipeline: simulation and render threads, flush, colour range and resumed frames", "[pipeline]") {
   set_threads(1);  // the OpenMP runtime is not instrumented for ThreadSanitizer: one simulation thread
   const fs::path whole = scratch("whole"), split = scratch("split");
   const auto ranges = run_frames(whole, 0, 6);

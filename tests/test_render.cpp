@@ -384,7 +384,7 @@ TEST_CASE("render: bad input raises RenderError with a clear message", "[render]
   CHECK_THAT(msg, Catch::Contains("undefined_thing"));
 }
 
-TEST_CASE("render: PNG write/read round trip; a failed write leaves no file", "[render]") {
+TEST_CASE("render: PNG write/read round trip, a failed write leaves no file", "[render]") {
   const ScratchDir scratch("png");
   const fs::path& dir = scratch.path;
   Image image(6, 4, 10, 20, 30);
@@ -671,7 +671,7 @@ TEST_CASE("render: per-camera overrides (hide, color_by, colormap, range, clip) 
   CHECK(renderer.render(no_pressure, recoloured) == a);
 }
 
-TEST_CASE("render: a camera's own colour bar in its figure; other cameras keep the run-wide one",
+TEST_CASE("render: a camera's own colour bar in its figure, other cameras keep the run-wide one",
           "[render]") {
   const ScratchDir scratch("camera_bars");
   const fs::path& out = scratch.path;
@@ -721,7 +721,7 @@ TEST_CASE("render: a camera's own colour bar in its figure; other cameras keep t
   CHECK_FALSE(valve_sheet == sheet_of("valve", speed_bar));  // the bar is not the run-wide one
 }
 
-TEST_CASE("render: a run with per-camera overrides; the camera without them renders as before", "[render]") {
+TEST_CASE("render: a run with per-camera overrides, the camera without them renders as before", "[render]") {
   const ScratchDir scratch("camera_overrides");
   // The scene of the 1-vs-2-threads test above (its "oblique" camera has the golden render_run.png), plus a
   // front camera and the same view hiding "right" and colouring by speed.
