@@ -197,6 +197,7 @@ World::World(const Scene& scene)
                          scene_.bodies[P_.body[j]].name + "' overlap near " + fmt_vec(P_.x[i]) +
                          ": particles closer than half a spacing");
     }
+  nb_.release();  // its grid of cells of a quarter spacing is larger than the lists' grid
 
   // Inflow buffer particles join the bodies; fluid already beyond an outlet disc becomes outflow buffer.
   if (!scene_.open_boundaries.empty()) open_.setup(scene_, fluid_, P_);
@@ -229,7 +230,7 @@ World::World(const Scene& scene)
 
   // Spatial sort once, so neighbours sit close in memory from the first step.
   skin_ = 0.1 * kernel_.support;
-  nb_.build(P_.x, kernel_.support, fixed_mask());
+  nb_.bin(P_.x, kernel_.support);  // the cells alone: spatial_order() needs no lists
   permute(nb_.spatial_order());
   build_lists();
   fluid_pressure(P_, ctx_);

@@ -30,12 +30,9 @@ struct BoundsAcc {
 
 }  // namespace
 
-void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std::vector<uint8_t>& fixed) {
+void NeighborSearch::make_grid(const std::vector<Vec3>& x, double radius) {
   const std::size_t n = x.size();
-  offset_.assign(n + 1, 0);
-  index_.clear();
   cell_of_.resize(n);
-  if (n == 0) return;
 
   // Grid over the particles' bounding box. The cell count is capped at a few per particle so that a
   // sparse scene (two bodies far apart) cannot exhaust memory; bigger cells stay correct, only slower.
@@ -70,19 +67,42 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std:
       throw std::invalid_argument("periodic length shorter than 2.5 search radii");
     origin_[d] = periodic_.lo[d];
   }
-  const double cell_size[3] = {periodic_.on[0] ? periodic_.len[0] / dims_[0] : cell_,
-                               periodic_.on[1] ? periodic_.len[1] / dims_[1] : cell_,
-                               periodic_.on[2] ? periodic_.len[2] / dims_[2] : cell_};
-  const std::size_t ncell = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
+  for (int d = 0; d < 3; ++d) cell_size_[d] = periodic_.on[d] ? periodic_.len[d] / dims_[d] : cell_;
 
   auto cell_coord = [&](const Vec3& p, int d) {
-    const int c = static_cast<int>(std::floor((p[d] - origin_[d]) / cell_size[d]));
+    const int c = static_cast<int>(std::floor((p[d] - origin_[d]) / cell_size_[d]));
     return std::clamp(c, 0, dims_[d] - 1);
   };
   parallel_for(n, [&](std::size_t i) {
     const int cx = cell_coord(x[i], 0), cy = cell_coord(x[i], 1), cz = cell_coord(x[i], 2);
     cell_of_[i] = static_cast<uint32_t>((static_cast<std::size_t>(cz) * dims_[1] + cy) * dims_[0] + cx);
   });
+}
+
+void NeighborSearch::bin(const std::vector<Vec3>& x, double radius) {
+  offset_.clear();
+  index_.clear();
+  if (x.empty()) {
+    cell_of_.clear();
+    return;
+  }
+  make_grid(x, radius);
+}
+
+void NeighborSearch::release() {
+  NeighborSearch empty;
+  empty.periodic_ = periodic_;
+  *this = std::move(empty);
+}
+
+void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std::vector<uint8_t>& fixed) {
+  const std::size_t n = x.size();
+  offset_.assign(n + 1, 0);
+  index_.clear();
+  cell_of_.resize(n);
+  if (n == 0) return;
+  make_grid(x, radius);
+  const std::size_t ncell = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
 
   // Counting sort of particles into cells: stable, so each cell lists its particles by index.
   cell_start_.assign(ncell + 1, 0);
@@ -168,33 +188,78 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std:
           }
   };
 
-  // One pass over fixed, contiguous chunks of particles (their number does not depend on the thread count),
-  // each into its own buffer; the buffers are then concatenated in chunk order.
+  // Fixed, contiguous chunks of particles (their number does not depend on the thread count), each listed
+  // into its own buffer and appended to index_ in chunk order. The chunks are taken in waves of a few dozen
+  // so that only one wave's buffers exist beside index_ (the lists are never held twice); a wave's chunks
+  // are balanced dynamically over the threads.
   const std::size_t chunks = std::clamp<std::size_t>(n / 512, 1, 1024);
-  std::vector<std::vector<uint32_t>> local(chunks);
-  parallel_for_dynamic_chunks(chunks, [&](std::size_t c) {
-    const std::size_t b = n * c / chunks, e = n * (c + 1) / chunks;
-    auto& out = local[c];
-    out.reserve((e - b) * 64);
-    for (std::size_t i = b; i < e; ++i) {
-      visit(i, [&](uint32_t j) { out.push_back(j); });
-      offset_[i + 1] = static_cast<uint32_t>(out.size());  // local count, made global below
+  const std::size_t wave = std::min<std::size_t>(chunks, 32);
+  // index_ keeps its capacity between builds. Before the first one it is sized from the candidates the
+  // stencils hold: a ball of the radius fills 4/3 pi / 2.5^3 = 26.8 % of the 5^3 cells of edge radius / 2
+  // around it, so 28 % of the candidates (a fixed particle's: the moving ones only) is a slight overestimate
+  // for evenly spread particles. Growing index_ by doubling instead would hold the lists twice while it
+  // copies them; pages reserved but never written cost no memory.
+  if (index_.capacity() == 0) {
+    std::vector<uint32_t> moving_in_cell;
+    if (any_fixed) {
+      moving_in_cell.assign(ncell, 0);
+      for (std::size_t i = 0; i < n; ++i)
+        if (!fixed[i]) ++moving_in_cell[cell_of_[i]];
     }
-  });
-  std::vector<std::size_t> chunk_base(chunks + 1, 0);
-  for (std::size_t c = 0; c < chunks; ++c) chunk_base[c + 1] = chunk_base[c] + local[c].size();
-  if (chunk_base[chunks] > std::numeric_limits<uint32_t>::max())
-    throw std::length_error("neighbour list over 4e9 pairs: reduce the resolution");
-  index_.resize(chunk_base[chunks]);
-  parallel_for_dynamic_chunks(chunks, [&](std::size_t c) {
-    const std::size_t b = n * c / chunks, e = n * (c + 1) / chunks;
-    for (std::size_t i = b; i < e; ++i) offset_[i + 1] += static_cast<uint32_t>(chunk_base[c]);
-    std::copy(local[c].begin(), local[c].end(), index_.begin() + static_cast<std::ptrdiff_t>(chunk_base[c]));
-  });
+    std::size_t candidates = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const bool fixed_i = any_fixed && fixed[i];
+      const uint32_t c = cell_of_[i];
+      const int cx = static_cast<int>(c % dims_[0]);
+      const int cy = static_cast<int>((c / dims_[0]) % dims_[1]);
+      const int cz = static_cast<int>(c / (static_cast<std::size_t>(dims_[0]) * dims_[1]));
+      const Runs rx = runs(cx, 0), ry = runs(cy, 1), rz = runs(cz, 2);
+      for (int iz = 0; iz < rz.n; ++iz)
+        for (int z = rz.lo[iz]; z <= rz.hi[iz]; ++z)
+          for (int iy = 0; iy < ry.n; ++iy)
+            for (int y = ry.lo[iy]; y <= ry.hi[iy]; ++y) {
+              const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
+              for (int ix = 0; ix < rx.n; ++ix) {
+                const std::size_t first = row + rx.lo[ix], last = row + rx.hi[ix];
+                if (!fixed_i) {
+                  candidates += cell_start_[last + 1] - cell_start_[first];
+                } else {
+                  for (std::size_t cell = first; cell <= last; ++cell) candidates += moving_in_cell[cell];
+                }
+              }
+            }
+    }
+    index_.reserve(static_cast<std::size_t>(0.28 * static_cast<double>(candidates)) + n);
+  }
+  std::vector<std::vector<uint32_t>> local(wave);
+  for (std::size_t c0 = 0; c0 < chunks; c0 += wave) {
+    const std::size_t cw = std::min(wave, chunks - c0);
+    parallel_for_dynamic_chunks(cw, [&](std::size_t w) {
+      const std::size_t c = c0 + w;
+      const std::size_t b = n * c / chunks, e = n * (c + 1) / chunks;
+      auto& out = local[w];
+      out.clear();
+      for (std::size_t i = b; i < e; ++i) {
+        visit(i, [&](uint32_t j) { out.push_back(j); });
+        offset_[i + 1] = static_cast<uint32_t>(out.size());  // local count, made global below
+      }
+    });
+    for (std::size_t w = 0; w < cw; ++w) {
+      const std::size_t c = c0 + w;
+      const std::size_t b = n * c / chunks, e = n * (c + 1) / chunks;
+      const std::size_t base = index_.size();
+      if (base + local[w].size() > std::numeric_limits<uint32_t>::max())
+        throw std::length_error("neighbour list over 4e9 pairs: reduce the resolution");
+      for (std::size_t i = b; i < e; ++i) offset_[i + 1] += static_cast<uint32_t>(base);
+      index_.insert(index_.end(), local[w].begin(), local[w].end());
+    }
+  }
+  index_written_ = std::max(index_written_, index_.size());
 }
 
 std::size_t NeighborSearch::bytes() const {
-  return (offset_.capacity() + index_.capacity() + cell_of_.capacity() + cell_start_.capacity() +
+  // index_: the entries ever written, not its capacity (reserved pages never written are not resident).
+  return (offset_.capacity() + index_written_ + cell_of_.capacity() + cell_start_.capacity() +
           cell_items_.capacity()) *
          sizeof(uint32_t);
 }

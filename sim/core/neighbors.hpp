@@ -22,6 +22,11 @@ class NeighborSearch {
   // grid then spans the domain on those axes, which must hold at least 2 * kReach + 1 = 5 cells of radius / 2
   // (the loader checks the period; build() throws std::invalid_argument otherwise).
   void build(const std::vector<Vec3>& x, double radius, const std::vector<uint8_t>& fixed = {});
+  // Only the cell grid and each particle's cell, as build() makes them, without the lists: enough for
+  // spatial_order(), at a fraction of the cost and memory. The lists are left empty (size() == 0).
+  void bin(const std::vector<Vec3>& x, double radius);
+  // Frees every buffer (lists and cell grid), keeping the periodic axes.
+  void release();
   void set_periodic(const Periodic& p) { periodic_ = p; }
   const Periodic& periodic() const { return periodic_; }
 
@@ -39,6 +44,7 @@ class NeighborSearch {
  private:
   std::vector<uint32_t> offset_;
   std::vector<uint32_t> index_;
+  std::size_t index_written_ = 0;  // most entries index_ has held (its capacity may be larger, unwritten)
   // Cell grid of the last build.
   Vec3 origin_ = Vec3::Zero();
   double cell_ = 1.0;
@@ -46,7 +52,10 @@ class NeighborSearch {
   std::vector<uint32_t> cell_of_;     // cell index of each particle
   std::vector<uint32_t> cell_start_;  // CSR over cells
   std::vector<uint32_t> cell_items_;
+  double cell_size_[3] = {1.0, 1.0, 1.0};  // cell edge per axis (a periodic axis divides its period evenly)
   Periodic periodic_;
+
+  void make_grid(const std::vector<Vec3>& x, double radius);
 };
 
 }  // namespace aortasph
