@@ -1,0 +1,500 @@
+// aortasph study STUDY.json: a parameter sweep of `aortasph run` jobs on Snakemake (docs/studies.md, issue 19
+// items 2-5). This file only reads and checks the study, writes the workflow (DIR/Snakefile,
+// DIR/variants.csv, DIR/study.json, DIR/study_report.py) and hands it to snakemake: scheduling, skipping
+// finished variants and the cluster back ends are Snakemake's.
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "embedded_scripts.hpp"
+#include "errors.hpp"
+#include "physiology/valve_metrics.hpp"
+#include "scene_loader.hpp"
+
+extern char** environ;
+
+namespace aortasph {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+const char* kStudyUsage =
+    "usage: aortasph study STUDY.json [--out DIR] [-j N] [--dry-run] [--cluster-hint]\n";
+
+struct Parameter {
+  std::string path;   // a --set path (dots, list indices as numbers)
+  std::string label;  // column name in variants.csv / metrics.csv (default: the path)
+  std::vector<json> values;
+};
+
+struct Study {
+  fs::path file;
+  std::string name, title, description;
+  fs::path scene;  // absolute
+  std::vector<Parameter> parameters;
+  std::vector<std::string> fixed;  // KEY=VALUE
+  std::vector<std::string> metrics;
+  int threads = 1;
+  double checkpoint_every = 0.0;  // 0: a tenth of the run
+  bool render = false;
+  json report;
+};
+
+[[noreturn]] void fail(const Study& s, const std::string& path, const std::string& message) {
+  throw InputError(s.file.string() + ": " + path + ": " + message);
+}
+
+void check_keys(const Study& s, const json& j, const std::string& path, const std::set<std::string>& keys) {
+  if (!j.is_object()) fail(s, path.empty() ? "study" : path, "expected an object");
+  for (const auto& [k, v] : j.items())
+    if (!keys.count(k)) fail(s, path.empty() ? k : path + "." + k, "unknown key");
+}
+
+// The JSON value at a --set path of the resolved scene, or nullptr.
+const json* at_path(const json& root, const std::string& key) {
+  const json* node = &root;
+  std::stringstream ss(key);
+  for (std::string part; std::getline(ss, part, '.');) {
+    if (node->is_array()) {
+      char* end = nullptr;
+      const unsigned long i = std::strtoul(part.c_str(), &end, 10);
+      if (part.empty() || *end != '\0' || i >= node->size()) return nullptr;
+      node = &(*node)[i];
+    } else if (node->is_object() && node->contains(part)) {
+      node = &(*node)[part];
+    } else {
+      return nullptr;
+    }
+  }
+  return node;
+}
+
+double number_at(const Study& s, const json& j, const std::string& path) {
+  if (!j.is_number()) fail(s, path, "expected a number");
+  return j.get<double>();
+}
+
+// A value rounded to 12 significant digits (0.0168 * 1.1 is 0.01848, not 0.018480000000000003).
+json rounded(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.12g", v);
+  return std::stod(buf);
+}
+
+std::string set_item(const std::string& path, const json& value) {
+  return path + "=" + value.dump();
+}
+
+// Loads the base scene with the given --sets; an InputError becomes one naming the study's JSON path.
+LoadedScene load_variant(const Study& s, const std::vector<std::string>& sets, const std::string& path) {
+  try {
+    return load_scene(s.scene, sets);
+  } catch (const InputError& e) {
+    fail(s, path, e.what());
+  }
+}
+
+Study read_study(const fs::path& file) {
+  Study s;
+  s.file = file;
+  std::ifstream in(file);
+  if (!in) throw InputError(file.string() + ": cannot read the study file");
+  const json j = json::parse(in, nullptr, false);
+  if (j.is_discarded()) throw InputError(file.string() + ": not valid JSON");
+  check_keys(s, j, "",
+             {"name", "title", "description", "scene", "parameters", "fixed", "metrics", "run", "report"});
+  s.name = j.value("name", file.stem().string());
+  s.title = j.value("title", s.name);
+  s.description = j.value("description", "");
+  if (!j.contains("scene") || !j["scene"].is_string()) fail(s, "scene", "expected the base scene's path");
+  fs::path scene = j["scene"].get<std::string>();
+  if (scene.is_relative()) scene = file.parent_path() / scene;
+  std::error_code ec;
+  if (!fs::is_regular_file(scene, ec)) fail(s, "scene", "no such file '" + scene.string() + "'");
+  s.scene = fs::absolute(scene).lexically_normal();
+
+  if (j.contains("fixed")) {
+    if (!j["fixed"].is_object()) fail(s, "fixed", "expected an object of --set paths and values");
+    for (const auto& [k, v] : j["fixed"].items()) s.fixed.push_back(set_item(k, v));
+  }
+  if (j.contains("run")) {
+    const json& r = j["run"];
+    check_keys(s, r, "run", {"threads", "checkpoint_every", "render"});
+    if (r.contains("threads")) {
+      if (!r["threads"].is_number_integer() || r["threads"].get<int>() < 1)
+        fail(s, "run.threads", "expected an integer >= 1");
+      s.threads = r["threads"].get<int>();
+    }
+    if (r.contains("checkpoint_every")) {
+      s.checkpoint_every = number_at(s, r["checkpoint_every"], "run.checkpoint_every");
+      if (!(s.checkpoint_every > 0)) fail(s, "run.checkpoint_every", "must be positive");
+    }
+    if (r.contains("render")) {
+      if (!r["render"].is_boolean()) fail(s, "run.render", "expected true or false");
+      s.render = r["render"].get<bool>();
+    }
+  }
+  s.report = j.value("report", json::object());
+  check_keys(s, s.report, "report", {"title", "wiggers", "figures", "plots"});
+
+  // The base scene with the fixed --sets: every parameter path must exist in it (the loader names a bad one).
+  const LoadedScene base = load_variant(s, s.fixed, "fixed");
+  if (!base.scene.cycle)
+    fail(s, "scene",
+         "'" + s.scene.string() + "' has no cycle block: a study collects the cycles.csv metrics " +
+             "(docs/scenes.md \"The cardiac cycle\")");
+
+  if (!j.contains("parameters") || !j["parameters"].is_array() || j["parameters"].empty())
+    fail(s, "parameters", "empty sweep: expected a list of at least one parameter");
+  for (std::size_t i = 0; i < j["parameters"].size(); ++i) {
+    const json& p = j["parameters"][i];
+    const std::string where = "parameters[" + std::to_string(i) + "]";
+    check_keys(s, p, where, {"path", "label", "values", "range", "scale"});
+    Parameter par;
+    if (!p.contains("path") || !p["path"].is_string() || p["path"].get<std::string>().empty())
+      fail(s, where + ".path", "expected a --set path such as \"aortic_root.commissure_height\"");
+    par.path = p["path"].get<std::string>();
+    par.label = p.value("label", par.path);
+    const json* current = at_path(base.resolved, par.path);
+    const int kinds = int(p.contains("values")) + int(p.contains("range")) + int(p.contains("scale"));
+    if (kinds != 1) fail(s, where, "expected exactly one of values, range, scale");
+    if (p.contains("values")) {
+      if (!p["values"].is_array()) fail(s, where + ".values", "expected a list");
+      for (const json& v : p["values"]) par.values.push_back(v);
+    } else if (p.contains("range")) {
+      const json& r = p["range"];
+      check_keys(s, r, where + ".range", {"from", "to", "step"});
+      for (const char* k : {"from", "to", "step"})
+        if (!r.contains(k)) fail(s, where + ".range." + k, "missing");
+      const double from = number_at(s, r["from"], where + ".range.from");
+      const double to = number_at(s, r["to"], where + ".range.to");
+      const double step = number_at(s, r["step"], where + ".range.step");
+      if (!(step > 0)) fail(s, where + ".range.step", "must be positive");
+      if (to < from) fail(s, where + ".range.to", "below range.from");
+      const double n = std::floor((to - from) / step + 1e-9);
+      if (n > 10000) fail(s, where + ".range", "more than 10000 values");
+      const bool integers = r["from"].is_number_integer() && r["step"].is_number_integer();
+      for (long k = 0; k <= static_cast<long>(n); ++k) {
+        if (integers)
+          par.values.push_back(r["from"].get<long>() + k * r["step"].get<long>());
+        else
+          par.values.push_back(rounded(from + k * step));
+      }
+    } else {
+      if (!p["scale"].is_array()) fail(s, where + ".scale", "expected a list of factors");
+      if (!current)
+        fail(s, where + ".path", "the scene has no '" + par.path + "' (scale multiplies its value)");
+      if (!current->is_number())
+        fail(s, where + ".scale", "'" + par.path + "' is not a number in the scene (scale multiplies it)");
+      for (std::size_t k = 0; k < p["scale"].size(); ++k)
+        par.values.push_back(
+            rounded(number_at(s, p["scale"][k], where + ".scale[" + std::to_string(k) + "]") *
+                    current->get<double>()));
+    }
+    const std::string list = p.contains("values") ? ".values" : p.contains("range") ? ".range" : ".scale";
+    if (par.values.empty()) fail(s, where + list, "empty sweep: no values");
+    // A path the resolved scene lacks may still be an optional key the loader accepts: it decides.
+    if (!current) {
+      std::vector<std::string> sets = s.fixed;
+      sets.push_back(set_item(par.path, par.values[0]));
+      load_variant(s, sets, where + ".path");
+    }
+    // Each value alone (with the fixed sets): the loader checks its type and range.
+    for (std::size_t k = 0; k < par.values.size(); ++k) {
+      std::vector<std::string> sets = s.fixed;
+      sets.push_back(set_item(par.path, par.values[k]));
+      load_variant(
+          s, sets,
+          where + list +
+              (p.contains("values") || p.contains("scale") ? "[" + std::to_string(k) + "]"
+                                                           : " (value " + par.values[k].dump() + ")"));
+    }
+    s.parameters.push_back(par);
+  }
+
+  // The metrics: cycles.csv columns (all of them by default).
+  std::vector<std::string> columns;
+  for (const auto& [name, value] : metric_table(CycleMetrics{})) columns.push_back(name);
+  if (j.contains("metrics")) {
+    if (!j["metrics"].is_array() || j["metrics"].empty())
+      fail(s, "metrics", "expected a list of column names");
+    for (std::size_t k = 0; k < j["metrics"].size(); ++k) {
+      const json& m = j["metrics"][k];
+      const std::string where = "metrics[" + std::to_string(k) + "]";
+      if (!m.is_string()) fail(s, where, "expected a cycles.csv column name");
+      if (std::find(columns.begin(), columns.end(), m.get<std::string>()) == columns.end())
+        fail(s, where, "'" + m.get<std::string>() + "' is not a cycles.csv column (docs/valve-metrics.md)");
+      s.metrics.push_back(m.get<std::string>());
+    }
+  } else {
+    for (const auto& c : columns)
+      if (c != "cycle") s.metrics.push_back(c);
+  }
+  return s;
+}
+
+struct Variant {
+  std::string id;
+  std::vector<json> values;  // one per parameter
+  std::vector<std::string> sets;
+};
+
+std::vector<Variant> variants_of(const Study& s) {
+  std::size_t total = 1;
+  for (const auto& p : s.parameters) {
+    total *= p.values.size();
+    if (total > 10000) throw InputError(s.file.string() + ": parameters: more than 10000 variants");
+  }
+  std::vector<Variant> out;
+  const int width = total > 1000 ? 4 : 3;
+  for (std::size_t n = 0; n < total; ++n) {
+    Variant v;
+    char id[16];
+    std::snprintf(id, sizeof id, "v%0*zu", width, n);
+    v.id = id;
+    v.sets = s.fixed;
+    std::size_t rest = n, stride = total;
+    for (const auto& p : s.parameters) {  // the first parameter varies slowest
+      stride /= p.values.size();
+      const json& value = p.values[rest / stride];
+      rest %= stride;
+      v.values.push_back(value);
+      v.sets.push_back(set_item(p.path, value));
+    }
+    out.push_back(v);
+  }
+  return out;
+}
+
+std::string csv_cell(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string q = "\"";
+  for (char c : text) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+std::string py_str(const std::string& text) {
+  return json(text).dump();
+}  // a JSON string is a Python literal
+
+// Writes a file only when its content changes (Snakemake's rerun triggers look at the Snakefile's code).
+void write_if_changed(const fs::path& file, const std::string& text) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream old;
+  old << in.rdbuf();
+  if (in && old.str() == text) return;
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+  if (!out) throw InputError(file.string() + ": cannot write");
+}
+
+std::string self_executable() {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string("aortasph") : p.string();
+}
+
+// The python of the report rule: $AORTASPH_PYTHON, else Debian's /usr/bin/python3 (where python3-matplotlib
+// installs; a python3 earlier on PATH may lack it), else python3 on PATH.
+std::string report_python() {
+  if (const char* env = std::getenv("AORTASPH_PYTHON"); env && *env) return env;
+  return access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
+}
+
+std::string snakefile(const Study& s, const std::vector<Variant>& variants, double checkpoint_every) {
+  std::ostringstream f;
+  f << "# Written by `aortasph study " << s.file.string() << "` (docs/studies.md); rewritten on each call.\n"
+    << "# Run it from this folder's parent: snakemake -s DIR/Snakefile -d DIR -j N\n"
+    << "import shlex\n\n"
+    << "AORTASPH = " << py_str(self_executable()) << "\n"
+    << "SCENE = " << py_str(s.scene.string()) << "\n"
+    << "CHECKPOINT_EVERY = " << json(checkpoint_every).dump() << "\n"
+    << "PYTHON = " << py_str(report_python()) << "\n"
+    << "RENDER = " << (s.render ? "True" : "False") << "\n"
+    << "# variant id -> its --set KEY=VALUE list (fixed sets first); variants.csv has the values\n"
+    << "VARIANTS = {\n";
+  for (const auto& v : variants) {
+    f << "    " << py_str(v.id) << ": [";
+    for (std::size_t k = 0; k < v.sets.size(); ++k) f << (k ? ", " : "") << py_str(v.sets[k]);
+    f << "],\n";
+  }
+  f << "}\n\n"
+    << "def run_command(wildcards, threads):\n"
+    << "    d = 'variants/' + wildcards.id\n"
+    << "    sets = ' '.join('--set ' + shlex.quote(x) for x in VARIANTS[wildcards.id])\n"
+    << "    run = (f'{shlex.quote(AORTASPH)} run {shlex.quote(SCENE)} {sets} --out {d} --threads {threads} "
+       "'\n"
+    << "           f'--checkpoint-every {CHECKPOINT_EVERY} --quiet' + ('' if RENDER else ' --no-render'))\n"
+    << "    resume = f'{shlex.quote(AORTASPH)} resume {d} --threads {threads} --quiet'\n"
+    << "    ok = f'grep -q \\'\"status\": *\"ok\"\\' {d}/run.json && test -f {d}/cycles.csv'\n"
+    << "    # finished before (the marker lost) -> nothing to run; a checkpoint of an unfinished run -> "
+       "resume\n"
+    << "    return (f'if {ok}; then :; elif test -f {d}/checkpoint.bin && test -f {d}/run.json; '\n"
+    << "            f'then {resume}; else {run}; fi && {ok}')\n\n"
+    << "rule all:\n"
+    << "    input: \"metrics.csv\", \"report.html\"\n\n"
+    << "rule variant:\n"
+    << "    output: \"variants/{id}/complete\"\n"
+    << "    log: \"variants/{id}/log.txt\"\n"
+    << "    threads: " << s.threads << "\n"
+    << "    params: cmd=run_command\n"
+    << "    shell: \"mkdir -p variants/{wildcards.id} && ({params.cmd}) > {log} 2>&1 && date -u > "
+       "{output}\"\n\n"
+    << "rule report:\n"
+    << "    input: expand(\"variants/{id}/complete\", id=list(VARIANTS))\n"
+    << "    output: \"metrics.csv\", \"report.html\"\n"
+    << "    params: python=shlex.quote(PYTHON)\n"
+    << "    shell: \"{params.python} study_report.py .\"\n";
+  return f.str();
+}
+
+std::string cluster_hint(const fs::path& snake, const fs::path& dir, const Study& s) {
+  std::ostringstream o;
+  o << "on a Slurm cluster (Snakemake 7.21's --slurm executor; the same files, skipping finished variants):\n"
+    << "  snakemake -s " << snake.string() << " -d " << dir.string()
+    << " --slurm --jobs 100 --rerun-incomplete --default-resources slurm_account=ACCOUNT "
+       "slurm_partition=PARTITION runtime=240 mem_mb=4000 --set-threads variant="
+    << s.threads << "\n"
+    << "or through sbatch directly:\n"
+    << "  snakemake -s " << snake.string() << " -d " << dir.string()
+    << " --jobs 100 --rerun-incomplete --cluster \"sbatch --cpus-per-task={threads} --time=04:00:00\"\n";
+  return o.str();
+}
+
+int spawn_wait(const std::vector<std::string>& argv) {
+  std::vector<char*> cargs;
+  for (const auto& a : argv) cargs.push_back(const_cast<char*>(a.c_str()));
+  cargs.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawnp(&pid, cargs[0], nullptr, nullptr, cargs.data(), environ) != 0) return 127;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+}  // namespace
+
+int cmd_study(const std::vector<std::string>& args) {
+  fs::path file;
+  std::optional<fs::path> out;
+  int jobs = 1;
+  bool dry_run = false, hint_only = false;
+  for (std::size_t k = 0; k < args.size(); ++k) {
+    const std::string& a = args[k];
+    const bool has_value = k + 1 < args.size();
+    if (a == "--out" && has_value) {
+      out = args[++k];
+    } else if ((a == "-j" || a == "--jobs") && has_value) {
+      char* end = nullptr;
+      const long n = std::strtol(args[k + 1].c_str(), &end, 10);
+      if (*end != '\0' || n < 1) throw InputError(a + ": expected a positive integer, got " + args[k + 1]);
+      jobs = static_cast<int>(n);
+      ++k;
+    } else if (a == "--dry-run" || a == "-n") {
+      dry_run = true;
+    } else if (a == "--cluster-hint") {
+      hint_only = true;
+    } else if (!a.empty() && a[0] != '-' && file.empty()) {
+      file = a;
+    } else {
+      throw InputError(a + ": unknown option for study\n" + kStudyUsage);
+    }
+  }
+  if (file.empty()) throw InputError(std::string("study: missing the study file\n") + kStudyUsage);
+
+  const Study s = read_study(file);
+  const std::vector<Variant> variants = variants_of(s);
+  // Each variant loaded with all its sets (the combination may be what the loader refuses).
+  double checkpoint_every = s.checkpoint_every;
+  for (const auto& v : variants) {
+    const LoadedScene l = load_variant(s, v.sets, "parameters (variant " + v.id + ")");
+    if (checkpoint_every <= 0) checkpoint_every = std::max(l.scene.t_end / 10.0, 1e-6);
+  }
+
+  const fs::path dir = out ? *out : fs::path("out") / "studies" / s.name;
+  std::error_code ec;
+  fs::create_directories(dir / "variants", ec);
+  if (ec) throw InputError(dir.string() + ": cannot create the study folder: " + ec.message());
+
+  std::ostringstream table;
+  table << "id";
+  for (const auto& p : s.parameters) table << "," << csv_cell(p.label);
+  table << "\n";
+  for (const auto& v : variants) {
+    table << v.id;
+    for (const auto& value : v.values)
+      table << "," << csv_cell(value.is_string() ? value.get<std::string>() : value.dump());
+    table << "\n";
+  }
+  write_if_changed(dir / "variants.csv", table.str());
+
+  json info;
+  info["name"] = s.name;
+  info["title"] = s.report.value("title", s.title);
+  info["description"] = s.description;
+  info["study_file"] = fs::absolute(s.file).lexically_normal().string();
+  info["scene"] = s.scene.string();
+  info["fixed"] = s.fixed;
+  info["metrics"] = s.metrics;
+  info["report"] = s.report;
+  info["parameters"] = json::array();
+  for (const auto& p : s.parameters)
+    info["parameters"].push_back({{"path", p.path}, {"label", p.label}, {"values", p.values}});
+  info["variants"] = json::array();
+  for (const auto& v : variants) info["variants"].push_back({{"id", v.id}, {"sets", v.sets}});
+  write_if_changed(dir / "study.json", info.dump(2) + "\n");
+  write_if_changed(dir / "study_report.py", std::string(scripts::study_report_py));
+  const fs::path snake = dir / "Snakefile";
+  write_if_changed(snake, snakefile(s, variants, checkpoint_every));
+
+  std::printf("aortasph study: %s: %zu variants (%s), workflow in %s\n", s.name.c_str(), variants.size(),
+              (dir / "variants.csv").string().c_str(), snake.string().c_str());
+  const std::string hint = cluster_hint(snake, dir, s);
+  if (hint_only) {
+    std::fputs(hint.c_str(), stdout);
+    return 0;
+  }
+  std::fflush(stdout);
+  std::vector<std::string> cmd{"snakemake",   "-s", snake.string(),       "-d",
+                               dir.string(),  "-j", std::to_string(jobs), "--rerun-incomplete",
+                               "--keep-going"};
+  if (dry_run) cmd.push_back("-n");
+  const int rc = spawn_wait(cmd);
+  if (rc == 127) {
+    std::fprintf(stderr,
+                 "aortasph study: error: snakemake not found (Debian: apt-get install snakemake; "
+                 "scripts/install-deps.sh)\n");
+    return 2;
+  }
+  if (rc != 0) {
+    std::fprintf(stderr,
+                 "aortasph study: snakemake failed (exit %d); the logs are in %s/variants/*/log.txt\n", rc,
+                 dir.string().c_str());
+    return 1;
+  }
+  if (!dry_run)
+    std::printf("aortasph study: %s and %s\n", (dir / "metrics.csv").string().c_str(),
+                (dir / "report.html").string().c_str());
+  std::fputs(hint.c_str(), stdout);
+  return 0;
+}
+
+}  // namespace aortasph
