@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -42,6 +43,7 @@ struct Parameter {
   std::string path;   // a --set path (dots, list indices as numbers)
   std::string label;  // column name in variants.csv / metrics.csv (default: the path)
   std::vector<json> values;
+  std::vector<std::string> where;  // each value's JSON path in the study file
 };
 
 struct Study {
@@ -216,22 +218,25 @@ Study read_study(const fs::path& file) {
       sets.push_back(set_item(par.path, par.values[0]));
       load_variant(s, sets, where + ".path");
     }
-    // Each value alone (with the fixed sets): the loader checks its type and range.
-    for (std::size_t k = 0; k < par.values.size(); ++k) {
-      std::vector<std::string> sets = s.fixed;
-      sets.push_back(set_item(par.path, par.values[k]));
-      load_variant(
-          s, sets,
+    // Where each value is written in the study file (for messages): values[k], scale[k], range (value v).
+    for (std::size_t k = 0; k < par.values.size(); ++k)
+      par.where.push_back(
           where + list +
-              (p.contains("values") || p.contains("scale") ? "[" + std::to_string(k) + "]"
-                                                           : " (value " + par.values[k].dump() + ")"));
-    }
+          (p.contains("range") ? " (value " + par.values[k].dump() + ")" : "[" + std::to_string(k) + "]"));
     s.parameters.push_back(par);
   }
 
   // The metrics: cycles.csv columns (all of them by default).
   std::vector<std::string> columns;
   for (const auto& [name, value] : metric_table(CycleMetrics{})) columns.push_back(name);
+  // The per-pair coaptation columns follow the scene's coaptation probe (pairs of list positions A < B).
+  for (const auto& probe : base.scene.probes)
+    if (!base.scene.cycle->coaptation.empty() && probe.name == base.scene.cycle->coaptation)
+      for (std::size_t a = 0; a < probe.bodies.size(); ++a)
+        for (std::size_t b = a + 1; b < probe.bodies.size(); ++b)
+          for (const char* what : {"height", "length"})
+            columns.push_back(std::string("coaptation_") + what + "_" + std::to_string(a) + "_" +
+                              std::to_string(b) + "_mm");
   if (j.contains("metrics")) {
     if (!j["metrics"].is_array() || j["metrics"].empty())
       fail(s, "metrics", "expected a list of column names");
@@ -252,7 +257,8 @@ Study read_study(const fs::path& file) {
 
 struct Variant {
   std::string id;
-  std::vector<json> values;  // one per parameter
+  std::vector<json> values;        // one per parameter
+  std::vector<std::size_t> index;  // the value's position in each parameter's list
   std::vector<std::string> sets;
 };
 
@@ -274,6 +280,7 @@ std::vector<Variant> variants_of(const Study& s) {
     for (const auto& p : s.parameters) {  // the first parameter varies slowest
       stride /= p.values.size();
       const json& value = p.values[rest / stride];
+      v.index.push_back(rest / stride);
       rest %= stride;
       v.values.push_back(value);
       v.sets.push_back(set_item(p.path, value));
@@ -378,15 +385,34 @@ std::string cluster_hint(const fs::path& snake, const fs::path& dir, const Study
   return o.str();
 }
 
+// While snakemake runs: Ctrl-C (SIGINT to the terminal's process group) reaches snakemake and the runs
+// themselves, which stop cleanly (a checkpoint each); this process waits for that instead of dying first. A
+// SIGTERM sent to this process alone is passed on to snakemake.
+volatile sig_atomic_t g_child = 0;
+volatile sig_atomic_t g_interrupted = 0;
+void on_signal(int sig) {
+  g_interrupted = 1;
+  if (sig == SIGTERM && g_child > 0) ::kill(static_cast<pid_t>(g_child), SIGTERM);
+}
+
 int spawn_wait(const std::vector<std::string>& argv) {
   std::vector<char*> cargs;
   for (const auto& a : argv) cargs.push_back(const_cast<char*>(a.c_str()));
   cargs.push_back(nullptr);
   pid_t pid = 0;
   if (posix_spawnp(&pid, cargs[0], nullptr, nullptr, cargs.data(), environ) != 0) return 127;
+  g_child = pid;
+  struct sigaction sa = {}, old_int = {}, old_term = {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, &old_int);
+  sigaction(SIGTERM, &sa, &old_term);
   int status = 0;
   while (waitpid(pid, &status, 0) < 0) {
   }
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGTERM, &old_term, nullptr);
+  g_child = 0;
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
 }
 
@@ -425,8 +451,18 @@ int cmd_study(const std::vector<std::string>& args) {
   // Each variant loaded with all its sets (the combination may be what the loader refuses).
   double checkpoint_every = s.checkpoint_every;
   for (const auto& v : variants) {
-    const LoadedScene l = load_variant(s, v.sets, "parameters (variant " + v.id + ")");
-    if (checkpoint_every <= 0) checkpoint_every = std::max(l.scene.t_end / 10.0, 1e-6);
+    try {
+      const LoadedScene l = load_scene(s.scene, v.sets);
+      if (checkpoint_every <= 0) checkpoint_every = std::max(l.scene.t_end / 10.0, 1e-6);
+    } catch (const InputError& e) {
+      // Name the value at fault when one refuses alone (with the fixed sets), else the combination.
+      for (std::size_t k = 0; k < s.parameters.size(); ++k) {
+        std::vector<std::string> sets = s.fixed;
+        sets.push_back(set_item(s.parameters[k].path, v.values[k]));
+        load_variant(s, sets, s.parameters[k].where[v.index[k]]);
+      }
+      fail(s, "parameters (variant " + v.id + ")", e.what());
+    }
   }
 
   const fs::path dir = out ? *out : fs::path("out") / "studies" / s.name;
@@ -483,6 +519,12 @@ int cmd_study(const std::vector<std::string>& args) {
                  "aortasph study: error: snakemake not found (Debian: apt-get install snakemake; "
                  "scripts/install-deps.sh)\n");
     return 2;
+  }
+  if (g_interrupted) {
+    std::fprintf(stderr,
+                 "aortasph study: interrupted; the same command finishes the missing variants (an unfinished "
+                 "run resumes from its checkpoint)\n");
+    return 130;
   }
   if (rc != 0) {
     std::fprintf(stderr,

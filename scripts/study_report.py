@@ -130,7 +130,7 @@ def main():
 
     header = ["id"] + labels + ["spacing_mm", "status", "cycles"] + metrics
     with open(os.path.join(root, "metrics.csv"), "w", newline="") as f:
-        w = csv.writer(f)
+        w = csv.writer(f, lineterminator="\n")
         w.writerow(header)
         for r in rows:
             w.writerow([r[h] for h in header])
