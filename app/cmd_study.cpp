@@ -44,7 +44,19 @@ struct Parameter {
   std::string label;  // column name in variants.csv / metrics.csv (default: the path)
   std::vector<json> values;
   std::vector<std::string> where;  // each value's JSON path in the study file
+  // Zipped parameters set several paths together: each value is a list, one entry per path. A plain parameter
+  // has one path and its value is the value itself.
+  std::vector<std::string> paths, labels;
+  bool zipped = false;
 };
+
+// The --set items of one value of a parameter.
+std::vector<std::string> sets_of(const Parameter& p, const json& value);
+// The variants.csv cells of one value (one per path).
+std::vector<json> cells_of(const Parameter& p, const json& value) {
+  if (!p.zipped) return {value};
+  return std::vector<json>(value.begin(), value.end());
+}
 
 struct Study {
   fs::path file;
@@ -113,6 +125,57 @@ LoadedScene load_variant(const Study& s, const std::vector<std::string>& sets, c
   }
 }
 
+std::vector<std::string> sets_of(const Parameter& p, const json& value) {
+  std::vector<std::string> out;
+  const std::vector<json> cells = cells_of(p, value);
+  for (std::size_t k = 0; k < p.paths.size(); ++k) out.push_back(set_item(p.paths[k], cells[k]));
+  return out;
+}
+
+// { "paths": [A, B], "labels": [...], "values": [[a0, b0], [a1, b1], ...] }: A and B change together.
+Parameter zipped_parameter(const Study& s, const json& p, const std::string& where, const LoadedScene& base) {
+  check_keys(s, p, where, {"paths", "labels", "values"});
+  Parameter par;
+  par.zipped = true;
+  if (!p["paths"].is_array() || p["paths"].empty())
+    fail(s, where + ".paths", "expected a list of --set paths");
+  for (std::size_t k = 0; k < p["paths"].size(); ++k) {
+    if (!p["paths"][k].is_string() || p["paths"][k].get<std::string>().empty())
+      fail(s, where + ".paths[" + std::to_string(k) + "]", "expected a --set path");
+    par.paths.push_back(p["paths"][k].get<std::string>());
+  }
+  par.labels = par.paths;
+  if (p.contains("labels")) {
+    if (!p["labels"].is_array() || p["labels"].size() != par.paths.size())
+      fail(s, where + ".labels", "expected one label per path");
+    for (std::size_t k = 0; k < par.paths.size(); ++k) {
+      if (!p["labels"][k].is_string())
+        fail(s, where + ".labels[" + std::to_string(k) + "]", "expected a string");
+      par.labels[k] = p["labels"][k].get<std::string>();
+    }
+  }
+  par.path = par.paths[0];
+  par.label = par.labels[0];
+  if (!p.contains("values") || !p["values"].is_array())
+    fail(s, where + ".values", "expected a list of value lists, one entry per path");
+  if (p["values"].empty()) fail(s, where + ".values", "empty sweep: no values");
+  for (std::size_t k = 0; k < p["values"].size(); ++k) {
+    const json& v = p["values"][k];
+    const std::string at = where + ".values[" + std::to_string(k) + "]";
+    if (!v.is_array() || v.size() != par.paths.size())
+      fail(s, at, "expected a list of " + std::to_string(par.paths.size()) + " values, one per path");
+    par.values.push_back(v);
+    par.where.push_back(at);
+  }
+  for (std::size_t k = 0; k < par.paths.size(); ++k)
+    if (!at_path(base.resolved, par.paths[k])) {
+      std::vector<std::string> sets = s.fixed;
+      sets.push_back(set_item(par.paths[k], par.values[0][k]));
+      load_variant(s, sets, where + ".paths[" + std::to_string(k) + "]");
+    }
+  return par;
+}
+
 Study read_study(const fs::path& file) {
   Study s;
   s.file = file;
@@ -168,6 +231,10 @@ Study read_study(const fs::path& file) {
   for (std::size_t i = 0; i < j["parameters"].size(); ++i) {
     const json& p = j["parameters"][i];
     const std::string where = "parameters[" + std::to_string(i) + "]";
+    if (p.is_object() && p.contains("paths")) {  // several paths that change together (zipped)
+      s.parameters.push_back(zipped_parameter(s, p, where, base));
+      continue;
+    }
     check_keys(s, p, where, {"path", "label", "values", "range", "scale"});
     Parameter par;
     if (!p.contains("path") || !p["path"].is_string() || p["path"].get<std::string>().empty())
@@ -223,6 +290,8 @@ Study read_study(const fs::path& file) {
       par.where.push_back(
           where + list +
           (p.contains("range") ? " (value " + par.values[k].dump() + ")" : "[" + std::to_string(k) + "]"));
+    par.paths = {par.path};
+    par.labels = {par.label};
     s.parameters.push_back(par);
   }
 
@@ -257,7 +326,7 @@ Study read_study(const fs::path& file) {
 
 struct Variant {
   std::string id;
-  std::vector<json> values;        // one per parameter
+  std::vector<json> values;        // the variants.csv cells: one per parameter path
   std::vector<std::size_t> index;  // the value's position in each parameter's list
   std::vector<std::string> sets;
 };
@@ -282,8 +351,8 @@ std::vector<Variant> variants_of(const Study& s) {
       const json& value = p.values[rest / stride];
       v.index.push_back(rest / stride);
       rest %= stride;
-      v.values.push_back(value);
-      v.sets.push_back(set_item(p.path, value));
+      for (const json& cell : cells_of(p, value)) v.values.push_back(cell);
+      for (const std::string& item : sets_of(p, value)) v.sets.push_back(item);
     }
     out.push_back(v);
   }
@@ -458,8 +527,9 @@ int cmd_study(const std::vector<std::string>& args) {
       // Name the value at fault when one refuses alone (with the fixed sets), else the combination.
       for (std::size_t k = 0; k < s.parameters.size(); ++k) {
         std::vector<std::string> sets = s.fixed;
-        sets.push_back(set_item(s.parameters[k].path, v.values[k]));
-        load_variant(s, sets, s.parameters[k].where[v.index[k]]);
+        const Parameter& p = s.parameters[k];
+        for (const std::string& item : sets_of(p, p.values[v.index[k]])) sets.push_back(item);
+        load_variant(s, sets, p.where[v.index[k]]);
       }
       fail(s, "parameters (variant " + v.id + ")", e.what());
     }
@@ -472,7 +542,8 @@ int cmd_study(const std::vector<std::string>& args) {
 
   std::ostringstream table;
   table << "id";
-  for (const auto& p : s.parameters) table << "," << csv_cell(p.label);
+  for (const auto& p : s.parameters)
+    for (const auto& label : p.labels) table << "," << csv_cell(label);
   table << "\n";
   for (const auto& v : variants) {
     table << v.id;
@@ -493,7 +564,7 @@ int cmd_study(const std::vector<std::string>& args) {
   info["report"] = s.report;
   info["parameters"] = json::array();
   for (const auto& p : s.parameters)
-    info["parameters"].push_back({{"path", p.path}, {"label", p.label}, {"values", p.values}});
+    info["parameters"].push_back({{"paths", p.paths}, {"labels", p.labels}, {"values", p.values}});
   info["variants"] = json::array();
   for (const auto& v : variants) info["variants"].push_back({{"id", v.id}, {"sets", v.sets}});
   write_if_changed(dir / "study.json", info.dump(2) + "\n");

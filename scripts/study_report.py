@@ -147,13 +147,18 @@ def main():
               file=sys.stderr)
     os.makedirs(os.path.join(root, "plots"), exist_ok=True)
     if plt is not None:
-        for k, label in enumerate(labels):
+        # A zipped parameter (several paths set together) is plotted against its first path; the lines are the
+        # combinations of the other parameters.
+        params = [p.get("labels", [p.get("label")]) for p in study["parameters"]]
+        for k, plabels in enumerate(params):
+            label = plabels[0]
+            others = [l for j, pl in enumerate(params) if j != k for l in pl]
             xs_all = [r[label] for r in rows]
             numeric = all(number(x) is not None for x in xs_all)
             order = sorted(set(xs_all), key=lambda x: number(x) if numeric else xs_all.index(x))
             groups = {}
             for r in rows:
-                key = tuple((l, r[l]) for l in labels if l != label)
+                key = tuple((l, r[l]) for l in others)
                 groups.setdefault(key, []).append(r)
             n = len(metrics)
             cols = min(3, n)
@@ -186,7 +191,7 @@ def main():
             name = "plots/parameter_%d.png" % k
             fig.savefig(os.path.join(root, name), dpi=90)
             plt.close(fig)
-            plots.append((label, name))
+            plots.append((" + ".join(plabels), name))
 
     # The header: the model as the variants ran it (their run.json scenes).
     models, bcs = {}, {}

@@ -234,6 +234,12 @@ TEST_CASE("study: bad study files exit 2 naming the JSON path, before anything i
        "study.json: metrics[1]: 'sv' is not a cycles.csv column"},
       {"{ " + scene + ", " + spacing + R"(, "run": { "threads": 0 } })", "study.json: run.threads: expected"},
       {"[1, 2", "study.json: not valid JSON"},
+      {"{ " + scene +
+           R"(, "parameters": [ { "paths": [ "resolution.spacing", "time.cfl" ], "values": [ [0.002] ] } ] })",
+       "study.json: parameters[0].values[0]: expected a list of 2 values, one per path"},
+      {"{ " + scene +
+           R"(, "parameters": [ { "paths": [ "resolution.spacing", "time.kfl" ], "values": [ [0.002, 0.2] ] } ] })",
+       "study.json: parameters[0].paths[1]: --set time.kfl=0.2: unknown path"},
   };
   for (const auto& [text, message] : cases) {
     std::ofstream(dir / "study.json") << text;
@@ -267,4 +273,26 @@ TEST_CASE("study: the shipped commissure-height study makes its workflow (dry ru
     CHECK(lines == table);
     CHECK(!fs::exists(out / "variants" / "v000" / "run.json"));  // nothing ran
   }
+}
+
+TEST_CASE("study: zipped parameters set several paths together, crossed with the other parameters",
+          "[study][cli]") {
+  const fs::path dir = scratch("study_zip"), out = dir / "out";
+  std::ofstream(dir / "study.json") << R"({ "scene": ")" << kRepo << R"(/scenes/tube_pulse.json",
+    "parameters": [
+      { "paths": [ "resolution.spacing", "time.cfl" ], "labels": [ "dx", "cfl" ], "values": [ [0.002, 0.25], [0.0025, 0.2] ] },
+      { "path": "open_boundaries.1.pressure", "range": { "from": 40, "to": 60, "step": 10 } } ] })";
+  std::string output;
+  // --cluster-hint: the workflow is written and the cluster command printed; nothing runs.
+  REQUIRE(run_study("study " + (dir / "study.json").string() + " --out " + out.string() + " --cluster-hint",
+                    output) == 0);
+  CHECK(output.find("--slurm") != std::string::npos);
+  CHECK(slurp(out / "variants.csv") ==
+        "id,dx,cfl,open_boundaries.1.pressure\nv000,0.002,0.25,40\nv001,0.002,0.25,50\nv002,0.002,0.25,60\n"
+        "v003,0.0025,0.2,40\nv004,0.0025,0.2,50\nv005,0.0025,0.2,60\n");
+  const auto info = nlohmann::json::parse(slurp(out / "study.json"));
+  CHECK(info["variants"][4]["sets"] ==
+        nlohmann::json({"resolution.spacing=0.0025", "time.cfl=0.2", "open_boundaries.1.pressure=50"}));
+  CHECK(fs::exists(out / "Snakefile"));
+  CHECK(!fs::exists(out / "variants" / "v000" / "run.json"));
 }
