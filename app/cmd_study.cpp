@@ -22,10 +22,14 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "core/sim_errors.hpp"
+#include "cycle_report.hpp"
 #include "embedded_scripts.hpp"
 #include "errors.hpp"
+#include "io/probes.hpp"
 #include "physiology/valve_metrics.hpp"
 #include "scene_loader.hpp"
+#include "world.hpp"
 
 extern char** environ;
 
@@ -110,6 +114,12 @@ json rounded(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.12g", v);
   return std::stod(buf);
+}
+
+std::string join_sets(const std::vector<std::string>& sets) {
+  std::string out;
+  for (const auto& x : sets) out += (out.empty() ? "" : " ") + x;
+  return out;
 }
 
 std::string set_item(const std::string& path, const json& value) {
@@ -398,7 +408,7 @@ std::string snakefile(const Study& s, const std::vector<Variant>& variants, doub
   std::ostringstream f;
   f << "# Written by `aortasph study " << s.file.string() << "` (docs/studies.md); rewritten on each call.\n"
     << "# Run it from this folder's parent: snakemake -s DIR/Snakefile -d DIR -j N\n"
-    << "import shlex\n\n"
+    << "import json\nimport os\nimport shlex\n\n"
     << "AORTASPH = " << py_str(self_executable()) << "\n"
     << "SCENE = " << py_str(s.scene.string()) << "\n"
     << "CHECKPOINT_EVERY = " << json(checkpoint_every).dump() << "\n"
@@ -411,33 +421,59 @@ std::string snakefile(const Study& s, const std::vector<Variant>& variants, doub
     for (std::size_t k = 0; k < v.sets.size(); ++k) f << (k ? ", " : "") << py_str(v.sets[k]);
     f << "],\n";
   }
-  f << "}\n\n"
-    << "def run_command(wildcards, threads):\n"
-    << "    d = 'variants/' + wildcards.id\n"
-    << "    sets = ' '.join('--set ' + shlex.quote(x) for x in VARIANTS[wildcards.id])\n"
-    << "    run = (f'{shlex.quote(AORTASPH)} run {shlex.quote(SCENE)} {sets} --out {d} --threads {threads} "
-       "'\n"
-    << "           f'--checkpoint-every {CHECKPOINT_EVERY} --quiet' + ('' if RENDER else ' --no-render'))\n"
-    << "    resume = f'{shlex.quote(AORTASPH)} resume {d} --threads {threads} --quiet'\n"
-    << "    ok = f'grep -q \\'\"status\": *\"ok\"\\' {d}/run.json && test -f {d}/cycles.csv'\n"
-    << "    # finished before (the marker lost) -> nothing to run; a checkpoint of an unfinished run -> "
-       "resume\n"
-    << "    return (f'if {ok}; then :; elif test -f {d}/checkpoint.bin && test -f {d}/run.json; '\n"
-    << "            f'then {resume}; else {run}; fi && {ok}')\n\n"
-    << "rule all:\n"
-    << "    input: \"metrics.csv\", \"report.html\"\n\n"
-    << "rule variant:\n"
-    << "    output: \"variants/{id}/complete\"\n"
-    << "    log: \"variants/{id}/log.txt\"\n"
-    << "    threads: " << s.threads << "\n"
-    << "    params: cmd=run_command\n"
-    << "    shell: \"mkdir -p variants/{wildcards.id} && ({params.cmd}) > {log} 2>&1 && date -u > "
-       "{output}\"\n\n"
-    << "rule report:\n"
-    << "    input: expand(\"variants/{id}/complete\", id=list(VARIANTS))\n"
-    << "    output: \"metrics.csv\", \"report.html\"\n"
-    << "    params: python=shlex.quote(PYTHON)\n"
-    << "    shell: \"{params.python} study_report.py .\"\n";
+  f << "}\n"
+    << R"SNK(
+def read_json(path):
+    try:
+        with open(path) as fh:
+            return json.load(fh)
+    except (OSError, ValueError):
+        return None
+
+def variant_job(vid, threads, log):
+    """Runs variant vid, or resumes it, or finds it done; raises unless it ends with status ok."""
+    d = "variants/" + vid
+    os.makedirs(d, exist_ok=True)
+    want = VARIANTS[vid]
+    had = read_json(d + "/sets.json")  # the --set list the folder's run was started with
+    run = read_json(d + "/run.json") or {}
+    status = run.get("status")
+    if had == want and status == "ok" and os.path.isfile(d + "/cycles.csv"):
+        return  # finished before (the marker was lost)
+    if had == want and status in ("interrupted", "running") and os.path.isfile(d + "/checkpoint.bin"):
+        cmd = [AORTASPH, "resume", d, "--threads", str(threads), "--quiet"]
+    else:  # a fresh run (an earlier one with other settings is replaced, its checkpoint removed by run)
+        with open(d + "/sets.json", "w") as fh:
+            json.dump(want, fh)
+        cmd = [AORTASPH, "run", SCENE] + [a for x in want for a in ("--set", x)]
+        cmd += ["--out", d, "--threads", str(threads), "--checkpoint-every", str(CHECKPOINT_EVERY), "--quiet"]
+        if not RENDER:
+            cmd.append("--no-render")
+    shell(" ".join(shlex.quote(c) for c in cmd) + " > " + shlex.quote(log) + " 2>&1")
+    run = read_json(d + "/run.json") or {}
+    if run.get("status") != "ok" or not os.path.isfile(d + "/cycles.csv"):
+        raise RuntimeError(vid + ": the run ended with status " + str(run.get("status")) + " (see " + log + ")")
+
+rule all:
+    input: "metrics.csv", "report.html"
+
+rule variant:
+    output: "variants/{id}/complete"
+    log: "variants/{id}/log.txt"
+    threads: )SNK"
+    << s.threads << R"SNK(
+    params: sets=lambda wildcards: VARIANTS[wildcards.id]
+    run:
+        variant_job(wildcards.id, threads, log[0])
+        with open(output[0], "w") as fh:
+            fh.write("ok\n")
+
+rule report:
+    input: expand("variants/{id}/complete", id=list(VARIANTS))
+    output: "metrics.csv", "report.html"
+    params: python=shlex.quote(PYTHON)
+    shell: "{params.python} study_report.py ."
+)SNK";
   return f.str();
 }
 
@@ -523,7 +559,16 @@ int cmd_study(const std::vector<std::string>& args) {
     try {
       const LoadedScene l = load_scene(s.scene, v.sets);
       if (checkpoint_every <= 0) checkpoint_every = std::max(l.scene.t_end / 10.0, 1e-6);
+      // As `aortasph check` does: the World is built (geometry, open-boundary buffers inside the domain) and
+      // the probes resolved, so that a variant the run would refuse is refused here, before any run starts.
+      try {
+        const World world(l.scene);
+        check_cycle_columns(l.scene, ProbeSet(l.scene, world).columns());
+      } catch (const SetupError& e) {
+        fail(s, "parameters (variant " + v.id + ": " + join_sets(v.sets) + ")", e.what());
+      }
     } catch (const InputError& e) {
+      if (std::string(e.what()).rfind(s.file.string() + ": ", 0) == 0) throw;
       // Name the value at fault when one refuses alone (with the fixed sets), else the combination.
       for (std::size_t k = 0; k < s.parameters.size(); ++k) {
         std::vector<std::string> sets = s.fixed;
@@ -531,7 +576,7 @@ int cmd_study(const std::vector<std::string>& args) {
         for (const std::string& item : sets_of(p, p.values[v.index[k]])) sets.push_back(item);
         load_variant(s, sets, p.where[v.index[k]]);
       }
-      fail(s, "parameters (variant " + v.id + ")", e.what());
+      fail(s, "parameters (variant " + v.id + ": " + join_sets(v.sets) + ")", e.what());
     }
   }
 
