@@ -229,7 +229,9 @@ def main():
     out.append("</tr>")
     for r in rows:
         cls = "" if r["status"] == "ok" else " class='bad'"
-        out.append("<tr%s>" % cls + "".join("<td>%s</td>" % e(str(r[h])) for h in header) + "</tr>")
+        cells = [r[h] if h in ("id", "status", "cycles") or number(r[h]) is None else "%.4g" % number(r[h])
+                 for h in header]  # 4 significant digits here; metrics.csv keeps every digit
+        out.append("<tr%s>" % cls + "".join("<td>%s</td>" % e(str(c)) for c in cells) + "</tr>")
     out.append("</table>")
 
     if plt is None:
