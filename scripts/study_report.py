@@ -89,6 +89,19 @@ def boundary_conditions(scene):
     return out or ["no open boundaries (closed domain)"]
 
 
+# Clinical targets of a repaired valve (issue 19 item 5): effective height 9-10 mm (Schaefers et al. 2006;
+# Bierbach et al. 2010), coaptation height >= 4 mm. (low, high) in the metric's unit; None: open.
+TARGETS = {"effective_height_mm": (9.0, 10.0)}
+
+
+def target_of(metric):
+    if metric in TARGETS:
+        return TARGETS[metric]
+    if metric.startswith("coaptation_height_") or metric == "central_coaptation_height_mm":
+        return (4.0, None)
+    return None
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit("usage: study_report.py DIR")
@@ -174,6 +187,14 @@ def main():
                         drawn = True
                         name = ", ".join("%s=%s" % kv for kv in key) or None
                         ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", label=name)
+                band = target_of(m)
+                if band is not None:
+                    lo, hi = band
+                    if hi is None:
+                        ax.axhline(lo, color="green", lw=0.8, ls="--")
+                        ax.axhspan(lo, max(lo * 1.5, ax.get_ylim()[1]), color="green", alpha=0.12, label="target")
+                    else:
+                        ax.axhspan(lo, hi, color="green", alpha=0.15, label="target")
                 if not drawn:
                     ax.text(0.5, 0.5, "not measured (empty in cycles.csv)", ha="center", va="center",
                             transform=ax.transAxes, fontsize=8, color="gray")
@@ -206,7 +227,7 @@ def main():
     out = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>%s</title>" % e(study["title"]),
            "<style>body{font-family:sans-serif;margin:1.5em}table{border-collapse:collapse;font-size:12px}"
            "td,th{border:1px solid #bbb;padding:2px 6px;text-align:right}th{background:#eee}"
-           ".bad{background:#fcc}img{max-width:100%}</style></head><body>",
+           ".bad{background:#fcc}.good{background:#cfc}img{max-width:100%}</style></head><body>",
            "<h1>%s</h1>" % e(study["title"]), "<p>%s</p>" % e(study.get("description", ""))]
     out.append("<h2>Model</h2><ul>")
     out.append("<li>Base scene: <code>%s</code>; fixed settings: <code>%s</code></li>" %
@@ -224,14 +245,24 @@ def main():
                "physiological.</li>" % e(", ".join(spacings) or "unknown"))
     out.append("</ul>")
 
-    out.append("<h2>Variants</h2><p><a href='metrics.csv'>metrics.csv</a></p><table><tr>")
+    out.append("<h2>Variants</h2><p><a href='metrics.csv'>metrics.csv</a>. Green / red cells: inside / outside "
+               "the clinical target (effective height 9&ndash;10 mm, coaptation height &ge; 4 mm); red rows: "
+               "runs that did not end with status ok.</p><table><tr>")
     out += ["<th>%s</th>" % e(h) for h in header]
     out.append("</tr>")
     for r in rows:
         cls = "" if r["status"] == "ok" else " class='bad'"
-        cells = [r[h] if h in ("id", "status", "cycles") or number(r[h]) is None else "%.4g" % number(r[h])
-                 for h in header]  # 4 significant digits here; metrics.csv keeps every digit
-        out.append("<tr%s>" % cls + "".join("<td>%s</td>" % e(str(c)) for c in cells) + "</tr>")
+        cells = []
+        for h in header:  # 4 significant digits here; metrics.csv keeps every digit
+            v = number(r[h]) if h not in ("id", "status", "cycles") else None
+            text = r[h] if v is None else "%.4g" % v
+            band = target_of(h) if h in metrics else None
+            light = ""
+            if band is not None and v is not None:  # traffic light: inside the target band or not
+                ok = v >= band[0] and (band[1] is None or v <= band[1])
+                light = " class='%s'" % ("good" if ok else "bad")
+            cells.append("<td%s>%s</td>" % (light, e(str(text))))
+        out.append("<tr%s>" % cls + "".join(cells) + "</tr>")
     out.append("</table>")
 
     if plt is None:

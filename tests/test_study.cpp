@@ -142,6 +142,21 @@ TEST_CASE("study: the CI study runs end to end through Snakemake; a second call 
   CHECK(output.find("Nothing to be done") != std::string::npos);
   CHECK(slurp(out / "metrics.csv") == before);
   CHECK(fs::last_write_time(out / "metrics.csv") == mtime);
+
+  // The traffic light of the report: an effective height (a tube has none: written in by hand here) inside
+  // the 9-10 mm target is green, outside red.
+  for (const auto& [id, value] : {std::pair{"v000", "9.5"}, {"v001", "7.2"}}) {
+    auto cycles = csv_rows(out / "variants" / id / "cycles.csv");
+    const auto col = std::find(cycles[0].begin(), cycles[0].end(), "effective_height_mm") - cycles[0].begin();
+    cycles.back()[col] = value;
+    std::ofstream f(out / "variants" / id / "cycles.csv");
+    for (const auto& row : cycles)
+      for (std::size_t k = 0; k < row.size(); ++k) f << row[k] << (k + 1 < row.size() ? "," : "\n");
+  }
+  REQUIRE(std::system(("cd " + out.string() + " && /usr/bin/python3 study_report.py . 2>&1").c_str()) == 0);
+  const std::string lit = slurp(out / "report.html");
+  CHECK(lit.find("<td class='good'>9.5</td>") != std::string::npos);
+  CHECK(lit.find("<td class='bad'>7.2</td>") != std::string::npos);
 }
 
 TEST_CASE("study: an interrupted study finishes only the missing variant, resumed from its checkpoint",
