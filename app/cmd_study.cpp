@@ -408,7 +408,7 @@ std::string snakefile(const Study& s, const std::vector<Variant>& variants, doub
   std::ostringstream f;
   f << "# Written by `aortasph study " << s.file.string() << "` (docs/studies.md); rewritten on each call.\n"
     << "# Run it from this folder's parent: snakemake -s DIR/Snakefile -d DIR -j N\n"
-    << "import json\nimport os\nimport shlex\n\n"
+    << "import json\nimport os\nimport shlex\nimport subprocess\n\n"
     << "AORTASPH = " << py_str(self_executable()) << "\n"
     << "SCENE = " << py_str(s.scene.string()) << "\n"
     << "CHECKPOINT_EVERY = " << json(checkpoint_every).dump() << "\n"
@@ -449,7 +449,8 @@ def variant_job(vid, threads, log):
         cmd += ["--out", d, "--threads", str(threads), "--checkpoint-every", str(CHECKPOINT_EVERY), "--quiet"]
         if not RENDER:
             cmd.append("--no-render")
-    shell(" ".join(shlex.quote(c) for c in cmd) + " > " + shlex.quote(log) + " 2>&1")
+    with open(log, "w") as out:  # the run's output goes to the variant's log
+        subprocess.run(cmd, stdout=out, stderr=subprocess.STDOUT, check=False)
     run = read_json(d + "/run.json") or {}
     if run.get("status") != "ok" or not os.path.isfile(d + "/cycles.csv"):
         raise RuntimeError(vid + ": the run ended with status " + str(run.get("status")) + " (see " + log + ")")
@@ -581,6 +582,10 @@ int cmd_study(const std::vector<std::string>& args) {
   }
 
   const fs::path dir = out ? *out : fs::path("out") / "studies" / s.name;
+  if (fs::absolute(dir).lexically_normal().string().find_first_of(" \t\n") != std::string::npos)
+    throw InputError("--out " + dir.string() + ": the study folder's path (" +
+                     fs::absolute(dir).lexically_normal().string() +
+                     ") has a space: Snakemake 7 cannot run jobs there (it changes into it unquoted)");
   std::error_code ec;
   fs::create_directories(dir / "variants", ec);
   if (ec) throw InputError(dir.string() + ": cannot create the study folder: " + ec.message());
