@@ -74,7 +74,8 @@ std::size_t count_of(const std::string& text, const std::string& what) {
 
 }  // namespace
 
-TEST_CASE("study: the CI study runs end to end through Snakemake; a second call runs nothing", "[study]") {
+TEST_CASE("study: the CI study runs end to end through Snakemake, and a second call runs nothing",
+          "[study]") {
   INFO("needs snakemake on PATH (scripts/install-deps.sh installs it)");
   REQUIRE(have_snakemake());
   const fs::path out = scratch("study_ci") / "out";
@@ -271,8 +272,7 @@ TEST_CASE("study: bad study files exit 2 naming the JSON path, before anything i
   }
 }
 
-TEST_CASE("study: zipped, range and scale parameters cross into variants; a dry run runs nothing",
-          "[study]") {
+TEST_CASE("study: zipped, range and scale parameters cross into the variants of a dry run", "[study]") {
   INFO("needs snakemake on PATH (scripts/install-deps.sh installs it)");
   REQUIRE(have_snakemake());
   const fs::path dir = scratch("study_zip"), out = dir / "out";
