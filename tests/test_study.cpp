@@ -2,7 +2,10 @@
 // through Snakemake (metrics.csv = the last cycle of each variant, report.html with its plots), a second call
 // runs nothing, an interrupted study finishes only the missing variant (resumed from its checkpoint), bad
 // study files exit 2 naming the JSON path before anything is written (also a variant the World refuses, as
-// `check` would), and zipped / range / scale parameters cross into the variants of a dry run.
+// `check` would), and zipped / range / scale parameters cross into the variants of a dry run. The two
+// end-to-end cases run a few thousand steps of real runs: tagged [long], so the sanitizer step of
+// scripts/test.sh leaves them out (the Release CTest step runs them: 7 s each measured, up to 22 s on busy
+// cores).
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -75,7 +78,7 @@ std::size_t count_of(const std::string& text, const std::string& what) {
 }  // namespace
 
 TEST_CASE("study: the CI study runs end to end through Snakemake, and a second call runs nothing",
-          "[study]") {
+          "[study][long]") {
   INFO("needs snakemake on PATH (scripts/install-deps.sh installs it)");
   REQUIRE(have_snakemake());
   const fs::path out = scratch("study_ci") / "out";
@@ -161,7 +164,7 @@ TEST_CASE("study: the CI study runs end to end through Snakemake, and a second c
 }
 
 TEST_CASE("study: an interrupted study finishes only the missing variant, resumed from its checkpoint",
-          "[study]") {
+          "[study][long]") {
   INFO("needs snakemake on PATH (scripts/install-deps.sh installs it)");
   REQUIRE(have_snakemake());
   const fs::path dir = scratch("study_resume"), out = dir / "out";
