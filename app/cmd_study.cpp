@@ -443,6 +443,9 @@ def variant_job(vid, threads, log):
     if had == want and status in ("interrupted", "running") and os.path.isfile(d + "/checkpoint.bin"):
         cmd = [AORTASPH, "resume", d, "--threads", str(threads), "--quiet"]
     else:  # a fresh run (an earlier one with other settings is replaced, its checkpoint removed by run)
+        for stale in ("run.json", "cycles.csv"):  # an earlier run's results must not pass for this one's
+            if os.path.exists(d + "/" + stale):
+                os.remove(d + "/" + stale)
         with open(d + "/sets.json", "w") as fh:
             json.dump(want, fh)
         cmd = [AORTASPH, "run", SCENE] + [a for x in want for a in ("--set", x)]
@@ -450,10 +453,11 @@ def variant_job(vid, threads, log):
         if not RENDER:
             cmd.append("--no-render")
     with open(log, "w") as out:  # the run's output goes to the variant's log
-        subprocess.run(cmd, stdout=out, stderr=subprocess.STDOUT, check=False)
+        rc = subprocess.run(cmd, stdout=out, stderr=subprocess.STDOUT, check=False).returncode
     run = read_json(d + "/run.json") or {}
-    if run.get("status") != "ok" or not os.path.isfile(d + "/cycles.csv"):
-        raise RuntimeError(vid + ": the run ended with status " + str(run.get("status")) + " (see " + log + ")")
+    if rc != 0 or run.get("status") != "ok" or not os.path.isfile(d + "/cycles.csv"):
+        raise RuntimeError(vid + ": the run exited " + str(rc) + " with status " + str(run.get("status")) +
+                           " (see " + log + ")")
 
 rule all:
     input: "metrics.csv", "report.html"
