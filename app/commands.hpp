@@ -45,6 +45,9 @@ struct BenchOptions {
 
 int cmd_bench(const BenchOptions& options);
 
+// aortasph study STUDY.json [--out DIR] [-j N] [--dry-run] [--cluster-hint] (docs/studies.md)
+int cmd_study(const std::vector<std::string>& args);
+
 // Parses the arguments after the subcommand word (throws InputError on bad arguments).
 RunOptions parse_run_options(const std::vector<std::string>& args);
 ResumeOptions parse_resume_options(const std::vector<std::string>& args);

@@ -26,6 +26,8 @@ const char* kUsage =
     "  aortasph movie DIR [--fps N]\n"
     "  aortasph plot DIR                                Wiggers plot (DIR/figures/wiggers.png) of a run\n"
     "                                                   with a cycle block (needs python3-matplotlib)\n"
+    "  aortasph study STUDY.json [--out DIR] [-j N] [--dry-run] [--cluster-hint]\n"
+    "                                                   a parameter sweep on Snakemake (docs/studies.md)\n"
     "  aortasph bench [--threads N] [--quick] [--render] [--json FILE] [--steps N]\n"
     "                [--case dam_break|aortic_root | --scene SCENE.json] [--set KEY=VALUE]...\n"
     "  aortasph --help | --version\n"
@@ -111,6 +113,7 @@ int dispatch(const std::vector<std::string>& args) {
   if (cmd == "compare") return cmd_compare(rest);
   if (cmd == "movie") return cmd_movie(rest);
   if (cmd == "plot") return cmd_plot(rest);
+  if (cmd == "study") return cmd_study(rest);
   throw InputError(cmd + ": unknown command (see aortasph --help)");
 }
 

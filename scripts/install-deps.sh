@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages aortasph builds and runs with (needs root, or sudo).
+# Installs the Debian 12 packages aortasph builds and runs with (needs root, or sudo); snakemake runs the
+# studies (aortasph study, docs/studies.md).
 set -euo pipefail
 # Usage: scripts/install-deps.sh [--clang]; --clang adds clang with its sanitizer and OpenMP runtimes (the
 # sanitizer and fuzzing builds of scripts/test.sh and scripts/fuzz.sh).
 packages=(cmake g++ make pkg-config libeigen3-dev nlohmann-json3-dev catch2
           libosmesa6-dev libglm-dev libstb-dev libpng-dev fonts-dejavu-core ffmpeg
-          python3-matplotlib)
+          python3-matplotlib snakemake)
 if [ "${1:-}" = --clang ]; then packages+=(clang libclang-rt-14-dev libomp-14-dev); fi
 missing=()
 for p in "${packages[@]}"; do
