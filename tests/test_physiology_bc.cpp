@@ -325,7 +325,7 @@ Rows run(const Scene& s, double t_end, const std::function<void(const World&)>& 
 }  // namespace
 
 TEST_CASE("pressure inlet: a pressure drop drives Poiseuille flow through a tube, and backflow",
-          "[physiology]") {
+          "[physiology][long]") {
   // nu = 1e-3 m^2/s in a tube of radius R = 4 mm: Re = 2 R V / nu ~ 0.04, developed within R^2 / nu = 16 ms.
   // 40 Pa over 16 mm: V = R^2 dp / (8 mu L) = 5 mm/s. The density varies by dp / (rho c0^2) = 1 %.
   // At R = 4 spacings the SPH tube's resistance wanders by +-15 % over 0.4 s (the same with a velocity inlet:

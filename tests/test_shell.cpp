@@ -237,7 +237,7 @@ TEST_CASE("shell: internal forces conserve linear and angular momentum", "[shell
 }
 
 TEST_CASE("shell: clamped circular plate under uniform pressure, centre deflection p a^4 / (64 D)",
-          "[shell]") {
+          "[shell][long]") {
   // a / t = 20, small deflection (w / t ~ 0.003), damped to static (mass-proportional damping 2 omega_1,
   // critical for the first mode: omega_1 = 10.22 sqrt(D / (rho t)) / a^2).
   const double a = 0.5, t = 0.025, E = 1e9, nu = 0.3, rho = 1000.0, p = 100.0;
@@ -295,7 +295,7 @@ double total_energy(const World& w) {
 }  // namespace
 
 TEST_CASE("shell: a cantilever strip's first frequency is Euler-Bernoulli's, and its energy is conserved",
-          "[shell]") {
+          "[shell][long]") {
   // L / t = 10, nu = 0 (plate strip = beam), 80 particles along, 3 across (Timoshenko's shear and rotary
   // inertia lower f1 by about 0.5 % at this slenderness). The error is first order in dx (the clamp: 8.6 %,
   // 5.4 %, 3.3 % low at 20, 40, 80 particles along; docs/validation.md). f1 = 1.875^2 / (2 pi L^2)

@@ -155,7 +155,7 @@ TEST_CASE("valve metrics: cycle windows and the periodic-state test", "[physiolo
 }
 
 TEST_CASE("probes for the valve metrics: stress percentile and coaptation of the closed aortic valve",
-          "[physiology]") {
+          "[physiology][long]") {
   std::vector<double> v;
   for (int i = 100; i >= 1; --i) v.push_back(i);
   CHECK(percentile_nearest_rank(v, 95.0) == 95.0);
@@ -231,7 +231,7 @@ nlohmann::json good_cycle() {
 }  // namespace
 
 TEST_CASE("cycle block: a short pulsatile tube run writes cycles.csv, run.json metrics and the Wiggers plot",
-          "[physiology][cli]") {
+          "[physiology][cli][long]") {
   const fs::path dir = scratch("valve_cycle");
   const fs::path scene = tube_cycle_scene(dir, good_cycle());
   const fs::path out = dir / "out";
