@@ -174,8 +174,8 @@ TEST_CASE("cli: bench --scene steps any scene and reports particle-steps, phases
   const fs::path dir = scratch("bench");
   const fs::path scene = write_file(dir, "tiny.json", kGood);
   const fs::path json = dir / "bench.json";
-  const Result r = aortasph("bench --scene " + scene.string() + " --steps 3 --threads 1 --json " + json.string() +
-                            " --set resolution.spacing=0.008");
+  const Result r = aortasph("bench --scene " + scene.string() + " --steps 3 --threads 1 --json " +
+                            json.string() + " --set resolution.spacing=0.008");
   INFO(r.err);
   REQUIRE(r.code == 0);
   const std::string j = slurp(json);
@@ -199,11 +199,12 @@ TEST_CASE("cli: bench --scene steps any scene and reports particle-steps, phases
   struct Case {
     std::string args, expect;
   };
-  for (const Case& c : std::vector<Case>{{"bench --case nosuch", "nosuch"},
-                                         {"bench --scene " + (dir / "missing.json").string(), "missing.json"},
-                                         {"bench --steps 0", "--steps"},
-                                         {"bench --scene " + scene.string() + " --case aortic_root", "--case"},
-                                         {"bench --set resolution.spacing=0.004", "--set"}}) {
+  for (const Case& c :
+       std::vector<Case>{{"bench --case nosuch", "nosuch"},
+                         {"bench --scene " + (dir / "missing.json").string(), "missing.json"},
+                         {"bench --steps 0", "--steps"},
+                         {"bench --scene " + scene.string() + " --case aortic_root", "--case"},
+                         {"bench --set resolution.spacing=0.004", "--set"}}) {
     const Result b = aortasph(c.args + " --json " + (dir / "x.json").string());
     INFO(c.args << ": exit " << b.code << ", stderr: " << b.err);
     CHECK(b.code == 2);
