@@ -483,13 +483,8 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
         break;
       }
       case kFluidToOutflow:
-        P.kind[i] = Kind::Outflow;
-        P.a[i] = Vec3::Zero();
-        state_.volume_out += P.m[i] / P.rho[i];
-        state_.mass_out += P.m[i];
-        break;
-      case kFluidToInflow:
-        P.kind[i] = Kind::Inflow;
+      case kFluidToInflow:  // fluid joining an outlet's or a pressure inlet's buffer leaves the domain
+        P.kind[i] = action[i] == kFluidToOutflow ? Kind::Outflow : Kind::Inflow;
         P.a[i] = Vec3::Zero();
         state_.volume_out += P.m[i] / P.rho[i];
         state_.mass_out += P.m[i];

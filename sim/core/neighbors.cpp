@@ -157,35 +157,36 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std:
     }
     return r;
   };
-  // Visit the candidates of i in a fixed order; call found(j) for each neighbour.
-  auto visit = [&](std::size_t i, auto&& found) {
-    const uint32_t c = cell_of_[i];
+  // The stencil of cell c: run(first, last) for each run of cells first .. last of one row (contiguous in
+  // cell_items_), rows in z, then y, order; the one order every sum over neighbours follows.
+  auto for_each_run = [&](uint32_t c, auto&& run) {
     const int cx = static_cast<int>(c % dims_[0]);
     const int cy = static_cast<int>((c / dims_[0]) % dims_[1]);
     const int cz = static_cast<int>(c / (static_cast<std::size_t>(dims_[0]) * dims_[1]));
     const Runs rx = runs(cx, 0), ry = runs(cy, 1), rz = runs(cz, 2);
-    const bool fixed_i = any_fixed && fixed[i];
-    const Vec3 xi = x[i];
     for (int iz = 0; iz < rz.n; ++iz)
       for (int z = rz.lo[iz]; z <= rz.hi[iz]; ++z)
         for (int iy = 0; iy < ry.n; ++iy)
           for (int y = ry.lo[iy]; y <= ry.hi[iy]; ++y) {
             const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
-            for (int ix = 0; ix < rx.n; ++ix) {
-              const int x0 = rx.lo[ix], x1 = rx.hi[ix];
-              if (fixed_i && std::none_of(&cell_moving[row + x0], &cell_moving[row + x1] + 1,
-                                          [](uint8_t m) { return m; }))
-                continue;
-              // Cells x0 .. x1 of one row are contiguous in cell_items_.
-              for (uint32_t k = cell_start_[row + x0]; k < cell_start_[row + x1 + 1]; ++k) {
-                if (fixed_i && fixed_s[k]) continue;
-                const Vec3 d = per.any ? per.image(xs[k] - xi) : Vec3(xs[k] - xi);
-                if (d.squaredNorm() >= r2) continue;
-                const uint32_t j = cell_items_[k];
-                if (j != i) found(j);
-              }
-            }
+            for (int ix = 0; ix < rx.n; ++ix) run(row + rx.lo[ix], row + rx.hi[ix]);
           }
+  };
+  // Visit the candidates of i in a fixed order; call found(j) for each neighbour.
+  auto visit = [&](std::size_t i, auto&& found) {
+    const bool fixed_i = any_fixed && fixed[i];
+    const Vec3 xi = x[i];
+    for_each_run(cell_of_[i], [&](std::size_t first, std::size_t last) {
+      if (fixed_i && std::none_of(&cell_moving[first], &cell_moving[last] + 1, [](uint8_t m) { return m; }))
+        return;
+      for (uint32_t k = cell_start_[first]; k < cell_start_[last + 1]; ++k) {
+        if (fixed_i && fixed_s[k]) continue;
+        const Vec3 d = per.any ? per.image(xs[k] - xi) : Vec3(xs[k] - xi);
+        if (d.squaredNorm() >= r2) continue;
+        const uint32_t j = cell_items_[k];
+        if (j != i) found(j);
+      }
+    });
   };
 
   // Fixed, contiguous chunks of particles (their number does not depend on the thread count), each listed
@@ -209,25 +210,13 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std:
     std::size_t candidates = 0;
     for (std::size_t i = 0; i < n; ++i) {
       const bool fixed_i = any_fixed && fixed[i];
-      const uint32_t c = cell_of_[i];
-      const int cx = static_cast<int>(c % dims_[0]);
-      const int cy = static_cast<int>((c / dims_[0]) % dims_[1]);
-      const int cz = static_cast<int>(c / (static_cast<std::size_t>(dims_[0]) * dims_[1]));
-      const Runs rx = runs(cx, 0), ry = runs(cy, 1), rz = runs(cz, 2);
-      for (int iz = 0; iz < rz.n; ++iz)
-        for (int z = rz.lo[iz]; z <= rz.hi[iz]; ++z)
-          for (int iy = 0; iy < ry.n; ++iy)
-            for (int y = ry.lo[iy]; y <= ry.hi[iy]; ++y) {
-              const std::size_t row = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0];
-              for (int ix = 0; ix < rx.n; ++ix) {
-                const std::size_t first = row + rx.lo[ix], last = row + rx.hi[ix];
-                if (!fixed_i) {
-                  candidates += cell_start_[last + 1] - cell_start_[first];
-                } else {
-                  for (std::size_t cell = first; cell <= last; ++cell) candidates += moving_in_cell[cell];
-                }
-              }
-            }
+      for_each_run(cell_of_[i], [&](std::size_t first, std::size_t last) {
+        if (!fixed_i) {
+          candidates += cell_start_[last + 1] - cell_start_[first];
+        } else {
+          for (std::size_t cell = first; cell <= last; ++cell) candidates += moving_in_cell[cell];
+        }
+      });
     }
     index_.reserve(static_cast<std::size_t>(0.28 * static_cast<double>(candidates)) + n);
   }

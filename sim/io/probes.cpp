@@ -155,6 +155,26 @@ void add_columns(std::vector<std::string>& cols, const std::string& name,
   for (const char* f : fields) cols.push_back(name + "." + f);
 }
 
+// Id of the particle of `body` nearest `point` at t = 0 (lowest id on ties): the particle a `point` or
+// `displacement` probe follows. Probe k names the probe in the error.
+uint32_t nearest_particle_id(const Particles& P, int body, const Vec3& point, std::size_t k,
+                             const std::string& name) {
+  double best = std::numeric_limits<double>::max();
+  uint32_t id = std::numeric_limits<uint32_t>::max();
+  bool found = false;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.body[i] != body) continue;
+    const double d = (P.x0[i] - point).squaredNorm();
+    if (d < best || (d == best && P.id[i] < id)) {
+      best = d;
+      id = P.id[i];
+      found = true;
+    }
+  }
+  if (!found) throw SetupError("probes[" + std::to_string(k) + "] '" + name + "': body has no particle");
+  return id;
+}
+
 }  // namespace
 
 double percentile_nearest_rank(std::vector<double> v, double q) {
@@ -196,20 +216,7 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
         break;
       case ProbeType::Point: {
         add_columns(columns_, pr.name, {"ux", "uy", "uz", "vx", "vy", "vz", "stress"});
-        // The particle of the body nearest the reference point at t = 0 (lowest id on ties).
-        double best = std::numeric_limits<double>::max();
-        bool found = false;
-        for (std::size_t i = 0; i < P.size(); ++i) {
-          if (P.body[i] != pr.body) continue;
-          const double d = (P.x0[i] - pr.reference).squaredNorm();
-          if (d < best || (d == best && P.id[i] < tracked_id_[k])) {
-            best = d;
-            tracked_id_[k] = P.id[i];
-            found = true;
-          }
-        }
-        if (!found)
-          throw SetupError("probes[" + std::to_string(k) + "] '" + pr.name + "': body has no particle");
+        tracked_id_[k] = nearest_particle_id(P, pr.body, pr.reference, k, pr.name);
         break;
       }
       case ProbeType::Energy:
@@ -243,21 +250,8 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
           columns_.push_back(pr.name + "." + c);
         break;
       case ProbeType::Displacement: {
-        // The body particle nearest the point at t = 0 (lowest id on ties), like `point`.
         add_columns(columns_, pr.name, {"ux", "uy", "uz"});
-        double best = std::numeric_limits<double>::max();
-        bool found = false;
-        for (std::size_t i = 0; i < P.size(); ++i) {
-          if (P.body[i] != pr.body) continue;
-          const double d = (P.x0[i] - pr.point).squaredNorm();
-          if (d < best || (d == best && P.id[i] < tracked_id_[k])) {
-            best = d;
-            tracked_id_[k] = P.id[i];
-            found = true;
-          }
-        }
-        if (!found)
-          throw SetupError("probes[" + std::to_string(k) + "] '" + pr.name + "': body has no particle");
+        tracked_id_[k] = nearest_particle_id(P, pr.body, pr.point, k, pr.name);
         break;
       }
     }

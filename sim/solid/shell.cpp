@@ -9,6 +9,7 @@
 #include "core/neighbors.hpp"
 #include "core/parallel.hpp"
 #include "core/sim_errors.hpp"
+#include "core/slot_map.hpp"
 #include "geometry/shapes.hpp"
 
 namespace aortasph {
@@ -176,22 +177,7 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
 }
 
 void Shells::reindex(const Particles& P) {
-  at_.assign(X_.size(), kNone);
-  slot_.assign(P.size(), kNone);
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    if (P.kind[i] != Kind::Shell || P.id[i] >= s_of_id_.size()) continue;
-    const uint32_t s = s_of_id_[P.id[i]];
-    if (s == kNone) continue;
-    at_[s] = static_cast<uint32_t>(i);
-    slot_[i] = s;
-  }
-  for (std::size_t s = 0; s < X_.size(); ++s)
-    if (at_[s] == kNone) {
-      std::ostringstream msg;
-      msg << "shell particle " << id_[s] << " (reference position " << X_[s].transpose()
-          << ") left the domain: its body cannot hold together without it";
-      throw InstabilityError(msg.str());
-    }
+  map_slots(P, Kind::Shell, s_of_id_, id_, X_, "shell", at_, slot_);
 }
 
 Vec3 Shells::normal(std::size_t s) const {

@@ -36,6 +36,7 @@
 
 #include "core/kernel.hpp"
 #include "core/particles.hpp"
+#include "core/slot_map.hpp"
 #include "solid/shell_material.hpp"
 
 namespace aortasph {
@@ -126,7 +127,7 @@ class Shells {
   const Vec3& free_axis(std::size_t s) const { return free_axis_[s]; }
 
  private:
-  static constexpr uint32_t kNone = 0xffffffffu;
+  static constexpr uint32_t kNone = kSlotNone;
   static constexpr int kGauss = 3;
   std::vector<ShellParams> params_;  // per material
   double h_ = 0.0;

@@ -10,6 +10,7 @@
 #include "core/neighbors.hpp"
 #include "core/parallel.hpp"
 #include "core/sim_errors.hpp"
+#include "core/slot_map.hpp"
 
 namespace aortasph {
 
@@ -218,22 +219,7 @@ Solids::Solids(const Particles& P, const std::vector<Material>& materials, const
 }
 
 void Solids::reindex(const Particles& P) {
-  at_.assign(X_.size(), kNone);
-  slot_.assign(P.size(), kNone);
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    if (P.kind[i] != Kind::Elastic || P.id[i] >= s_of_id_.size()) continue;
-    const uint32_t s = s_of_id_[P.id[i]];
-    if (s == kNone) continue;
-    at_[s] = static_cast<uint32_t>(i);
-    slot_[i] = s;
-  }
-  for (std::size_t s = 0; s < X_.size(); ++s)
-    if (at_[s] == kNone) {
-      std::ostringstream msg;
-      msg << "elastic particle " << id_[s] << " (reference position " << X_[s].transpose()
-          << ") left the domain: its body cannot hold together without it";
-      throw InstabilityError(msg.str());
-    }
+  map_slots(P, Kind::Elastic, s_of_id_, id_, X_, "elastic", at_, slot_);
 }
 
 Mat3 Solids::deformation_gradient(const Particles& P, std::size_t s) const {

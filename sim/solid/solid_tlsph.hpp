@@ -28,6 +28,7 @@
 
 #include "core/kernel.hpp"
 #include "core/particles.hpp"
+#include "core/slot_map.hpp"
 
 namespace aortasph {
 
@@ -106,7 +107,7 @@ class Solids {
   std::size_t reference_pairs() const { return nbr_.size(); }
 
  private:
-  static constexpr uint32_t kNone = 0xffffffffu;
+  static constexpr uint32_t kNone = kSlotNone;
   const CubicSpline* kernel_ = nullptr;
   std::vector<SolidParams> params_;  // per material
   double max_c_ = 0.0, min_mass_ = 0.0;
