@@ -186,9 +186,10 @@ World::World(const Scene& scene)
                            scene_.contact.friction, dx};
   if (P_.size() > std::numeric_limits<uint32_t>::max() / 4) throw SetupError("too many particles");
 
-  // Bodies may touch but not overlap: particles of two bodies closer than half a spacing are an error.
+  // Bodies may touch but not overlap: particles of two bodies closer than half a spacing are an error (less
+  // a rounding margin: a sheet on a fluid's lattice plane lies exactly half a spacing from its particles).
   nb_.set_periodic(ctx_.periodic);
-  nb_.build(P_.x, 0.5 * dx);
+  nb_.build(P_.x, 0.5 * dx * (1.0 - 1e-9));
   for (std::size_t i = 0; i < P_.size(); ++i)
     for (uint32_t k = nb_.begin(i); k < nb_.end(i); ++k) {
       const uint32_t j = nb_.index()[k];
@@ -224,6 +225,10 @@ World::World(const Scene& scene)
       if (P_.id[i] < shell_seed.size()) by_index[i] = shell_seed[P_.id[i]];
     shells_ = Shells(P_, scene_.materials, kernel_, by_index);
     shells_.update(P_);
+    if (have_fluid) {  // fluid on either side of a sheet (sim/boundary/shell_coupling.hpp)
+      coupling_ = ShellCoupling(P_, shells_, dx, kernel_.support, wall_ref_.rho0);
+      ctx_.shell_wall = &coupling_.wall();
+    }
   }
   if (!solids_.empty() && contact_.k > 0.0)
     min_contact_mass_ = std::min(min_contact_mass_, solids_.min_mass());
@@ -308,6 +313,7 @@ void World::build_lists() {
     nb_.build(P_.x, radius, fixed_mask());
     profile_.sort += seconds_since(t0);
   }
+  coupling_.on_build(P_, nb_);  // the rows near a shell, as built
   ++builds_;
   x_at_build_ = P_.x;
   lists_valid_ = true;
@@ -321,6 +327,8 @@ void World::build_lists() {
 void World::step(double dt) {
   update_neighbors();
   FluidContext& ctx = ctx_;
+  // Shells between fluids: pairs across a sheet masked, imaginary wall particles placed.
+  if (coupling_.active()) coupling_.prepare(P_, shells_, nb_, ctx.periodic);
 
   auto t0 = Clock::now();
   fluid_density_summation(P_, nb_, ctx);  // eq. (11), where a material asks for it
@@ -358,6 +366,7 @@ void World::step(double dt) {
   t0 = Clock::now();
   if (shifting_) fluid_shifting(P_, nb_, ctx_, scene_.spacing, dt, shift_);  // Lind et al. 2012
   integrate(dt);
+  if (coupling_.active()) coupling_.guard(P_, ctx_.periodic);  // no fluid particle through a sheet
   profile_.integrate += seconds_since(t0);
 
   // Open boundaries (sim/boundary/open_boundary.hpp): buffers move, particles that crossed an inlet or outlet
@@ -680,6 +689,11 @@ void World::save_state(StateWriter& out) const {
   sh.array(shells_.directors());
   sh.array(shells_.omegas());
 
+  if (coupling_.active()) {  // a section of its own: older checkpoints and shell-free scenes lack it
+    SectionWriter& sc = out.section("shell_coupling", 1);
+    sc.value(coupling_.crossings());
+  }
+
   SectionWriter& nb = out.section("neighbors", 1);
   nb.value(lists_valid_);
   nb.value(builds_);
@@ -766,6 +780,12 @@ void World::load_state(const StateReader& in) {
   if (lists_valid_) {
     if (x_at_build_.size() != n) nb.mismatch("x_at_build", x_at_build_.size(), n);
     nb_.build(x_at_build_, kernel_.support + skin_, fixed_mask());
+    coupling_.on_build(P_, nb_);
+  }
+  if (in.has("shell_coupling")) {
+    SectionReader sc = in.section("shell_coupling");
+    coupling_.set_crossings(sc.value<long>());
+    sc.done();
   }
 
   // The solid's reference configuration is rebuilt from the scene (it never changes); only its map from

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "boundary/open_boundary.hpp"
+#include "boundary/shell_coupling.hpp"
 #include "core/kernel.hpp"
 #include "core/neighbors.hpp"
 #include "core/particles.hpp"
@@ -133,6 +134,10 @@ class World {
     return s >= 0 ? solids_.mass(static_cast<std::size_t>(s)) : P_.m[i];
   }
   const Shells& shells() const { return shells_; }
+  // Fluid on both sides of the shells (sim/boundary/shell_coupling.hpp): fluid particles put back on their
+  // side of a sheet since t = 0 (0 when the coupling holds), and the pairs masked in the last step.
+  long shell_crossings() const { return coupling_.crossings(); }
+  std::size_t shell_masked_pairs() const { return coupling_.masked_pairs(); }
   Shells& shells_for_test() { return shells_; }
   const CubicSpline& kernel() const { return kernel_; }
   const std::vector<FluidParams>& fluid_params() const { return fluid_; }
@@ -192,7 +197,8 @@ class World {
   std::vector<RigidBody> rigid_;
   Solids solids_;
   Shells shells_;
-  OpenBoundaries open_;  // inflows and outflows; their counters are plain values (OpenBoundaryState)
+  ShellCoupling coupling_;  // active when a scene has shells and a fluid
+  OpenBoundaries open_;     // inflows and outflows; their counters are plain values (OpenBoundaryState)
   ContactParams contact_;
   double min_contact_mass_ = std::numeric_limits<double>::max();
   std::vector<Vec3> force_;   // per-particle force on body particles of the current step

@@ -82,6 +82,7 @@ void NeighborSearch::make_grid(const std::vector<Vec3>& x, double radius) {
 void NeighborSearch::bin(const std::vector<Vec3>& x, double radius) {
   offset_.clear();
   index_.clear();
+  row_end_.clear();
   if (x.empty()) {
     cell_of_.clear();
     return;
@@ -100,7 +101,10 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std:
   offset_.assign(n + 1, 0);
   index_.clear();
   cell_of_.resize(n);
-  if (n == 0) return;
+  if (n == 0) {
+    row_end_.clear();
+    return;
+  }
   make_grid(x, radius);
   const std::size_t ncell = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
 
@@ -244,6 +248,7 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std:
     }
   }
   index_written_ = std::max(index_written_, index_.size());
+  if (!row_end_.empty()) row_end_.assign(offset_.begin() + 1, offset_.end());
 }
 
 std::size_t NeighborSearch::bytes() const {

@@ -32,7 +32,18 @@ class NeighborSearch {
 
   std::size_t size() const { return offset_.empty() ? 0 : offset_.size() - 1; }
   uint32_t begin(std::size_t i) const { return offset_[i]; }
-  uint32_t end(std::size_t i) const { return offset_[i + 1]; }
+  uint32_t end(std::size_t i) const { return row_end_.empty() ? offset_[i + 1] : row_end_[i]; }
+  // Masked rows (sim/boundary/shell_coupling.hpp): a row's pairs may be reordered in place and its end set
+  // before offset[i+1], so that every loop over begin(i) .. end(i) skips the masked pairs at the row's tail.
+  // enable_row_ends() turns this on (build() then resets every end to the full row); unset, end(i) is the
+  // full row and nothing is stored.
+  void enable_row_ends() {
+    if (row_end_.empty() && !offset_.empty()) row_end_.assign(offset_.begin() + 1, offset_.end());
+  }
+  bool row_ends_enabled() const { return !row_end_.empty(); }
+  uint32_t full_end(std::size_t i) const { return offset_[i + 1]; }
+  uint32_t* row_data() { return index_.data(); }
+  void set_end(std::size_t i, uint32_t e) { row_end_[i] = e; }
   const std::vector<uint32_t>& index() const { return index_; }
   std::size_t pairs() const { return index_.size(); }
   std::size_t bytes() const;
@@ -44,6 +55,7 @@ class NeighborSearch {
  private:
   std::vector<uint32_t> offset_;
   std::vector<uint32_t> index_;
+  std::vector<uint32_t> row_end_;  // empty unless enable_row_ends()
   std::size_t index_written_ = 0;  // most entries index_ has held (its capacity may be larger, unwritten)
   // Cell grid of the last build.
   Vec3 origin_ = Vec3::Zero();

@@ -1,5 +1,7 @@
 #include "fluid/fluid_wcsph.hpp"
 
+#include <algorithm>
+
 #include "core/parallel.hpp"
 
 namespace aortasph {
@@ -14,7 +16,13 @@ void fluid_density_summation(Particles& P, const NeighborSearch& nb, const Fluid
     double rho = P.m[i] * w0;
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
-      rho += P.m[j] * ctx.kernel.W(ctx.separation(P.x[i], P.x[j]).norm());
+      const Vec3 xij = ctx.separation(P.x[i], P.x[j]);
+      if (ctx.shell_wall && P.kind[j] == Kind::Shell) {  // the shell's imaginary wall particles
+        const ShellWall& sw = *ctx.shell_wall;
+        sw.for_each_ghost(xij, j, [&](const Vec3& r) { rho += sw.ghost_mass[j] * ctx.kernel.W(r.norm()); });
+        continue;
+      }
+      rho += P.m[j] * ctx.kernel.W(xij.norm());
     }
     P.rho[i] = rho;
   });
@@ -55,6 +63,18 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
       const Vec3 xij = ctx.separation(xi, P.x[j]);
       const double r2 = xij.squaredNorm();
       if (r2 >= support2 || r2 <= 0.0) continue;  // Verlet-list pairs in the skin: the kernel is zero there
+      if (ctx.shell_wall && P.kind[j] == Kind::Shell) {
+        // The shell's imaginary wall particles move with the shell (fluid/shell_wall.hpp).
+        const ShellWall& sw = *ctx.shell_wall;
+        const Vec3 vij = vi - P.v[j];
+        sw.for_each_ghost(xij, j, [&](const Vec3& rg) {
+          const double rg2 = rg.squaredNorm();
+          if (rg2 >= support2) return;
+          const double rr = std::sqrt(rg2);
+          drho += sw.ghost_mass[j] * (K.dWdr(rr) / rr) * vij.dot(rg);
+        });
+        continue;
+      }
       const double r = std::sqrt(r2);
       const double dwdr_r = K.dWdr(r) / r;
       // Continuity, eq. (12) with x_ij = x_i - x_j, v_ij = v_i - v_j (the paper's minus sign belongs to
@@ -81,13 +101,14 @@ namespace {
 struct FluidI {
   std::size_t i;
   Vec3 x, v;
-  double rho, p_over_rho2;
+  double rho, p, p_over_rho2;
   const FluidParams* params;
   FluidI(const Particles& P, const FluidContext& ctx, std::size_t i)
       : i(i),
         x(P.x[i]),
         v(P.v[i]),
         rho(P.rho[i]),
+        p(P.p[i]),
         p_over_rho2(ctx.p_over_rho2[i]),
         params(&ctx.params[P.material[i]]) {}
 };
@@ -98,11 +119,55 @@ struct PairConstants {
       : h(K.h), eta2(0.01 * K.h * K.h), support2(K.support * K.support) {}  // 0.01 h^2 of eq. (10)
 };
 
+// Acceleration of fluid particle i due to one wall particle seen "locally" (fluid/shell_wall.hpp): at
+// r = x_i - x_g, of mass mg, moving at v_w with acceleration a_w, with the pressure p_i + rho_i (g - a_w) .
+// (x_g - x_i) extrapolated from i alone (cut at zero as for the other walls, boundary.cpp), its density from
+// the equation of state, no slip through the mirrored velocity 2 v_w - v_i. background, when given,
+// receives the background pressure's share (see fluid_reaction).
+inline Vec3 local_wall_term(const FluidContext& ctx, const PairConstants& c, const FluidI& I,
+                            const Vec3& r_ig, double mg, const Vec3& vij, const Vec3& g_minus_a,
+                            Vec3* background) {
+  const double r2 = r_ig.squaredNorm();
+  if (r2 >= c.support2 || r2 <= 0.0) return Vec3::Zero();
+  const FluidParams& fi = *I.params;
+  const double r = std::sqrt(r2);
+  const double dwdr = ctx.kernel.dWdr(r);
+  const Vec3 gradW = (dwdr / r) * r_ig;
+  const double pg = std::max(I.p + I.rho * g_minus_a.dot(-r_ig), 0.0);
+  const double rhog = fi.density(pg);
+  double scalar = -(I.p_over_rho2 + pg / (rhog * rhog));
+  if (fi.alpha > 0.0) {
+    const double vx = vij.dot(r_ig);
+    if (vx < 0.0) scalar += fi.alpha * fi.c0 * (c.h * vx / (r2 + c.eta2)) / (0.5 * (I.rho + rhog));
+  }
+  Vec3 acc = (mg * scalar) * gradW;
+  if (fi.nu > 0.0) acc += (fi.nu * mg * (1.0 / I.rho + 1.0 / rhog) * (r * dwdr) / (r2 + c.eta2) * 2.0) * vij;
+  if (background && fi.p_background != 0.0)
+    *background += (mg * fi.p_background * (1.0 / (I.rho * I.rho) + 1.0 / (rhog * rhog))) * gradW;
+  return acc;
+}
+
+// Acceleration of fluid particle i due to the imaginary wall particles of shell particle j
+// (fluid/shell_wall.hpp), each a local wall.
+inline Vec3 shell_acceleration(const Particles& P, const FluidContext& ctx, const PairConstants& c,
+                               const FluidI& I, std::size_t j, const Vec3& xij, Vec3* background) {
+  const ShellWall& sw = *ctx.shell_wall;
+  const double mg = sw.ghost_mass[j];
+  const Vec3 vij = I.v - P.v[j];
+  const Vec3 g_minus_a = ctx.gravity - P.a[j];
+  Vec3 acc = Vec3::Zero();
+  sw.for_each_ghost(
+      xij, j, [&](const Vec3& rg) { acc += local_wall_term(ctx, c, I, rg, mg, vij, g_minus_a, background); });
+  return acc;
+}
+
 inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx, const PairConstants& c,
-                              const FluidI& I, std::size_t j) {
+                              const FluidI& I, std::size_t j, Vec3* background = nullptr) {
   const Vec3 xij = ctx.separation(I.x, P.x[j]);
   const double r2 = xij.squaredNorm();
   if (r2 >= c.support2 || r2 <= 0.0) return Vec3::Zero();  // Verlet-list pairs in the skin
+  // The imaginary particles lie farther from i than j itself, so the early return above holds for them.
+  if (ctx.shell_wall && P.kind[j] == Kind::Shell) return shell_acceleration(P, ctx, c, I, j, xij, background);
   const FluidParams& fi = *I.params;
   const double h = c.h, eta2 = c.eta2;
   const double r = std::sqrt(r2);
@@ -151,7 +216,14 @@ void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ct
     if (P.kind[i] != Kind::Fluid) return;
     const FluidI I(P, ctx, i);
     Vec3 acc = Vec3::Zero();
-    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) acc += pair_acceleration(P, ctx, c, I, idx[k]);
+    const uint32_t end = nb.end(i);
+    const uint32_t local = ctx.shell_wall ? std::min(end, ctx.shell_wall->local_begin[i]) : end;
+    for (uint32_t k = nb.begin(i); k < local; ++k) acc += pair_acceleration(P, ctx, c, I, idx[k]);
+    for (uint32_t k = local; k < end; ++k) {  // walls across a sheet (fluid/shell_wall.hpp)
+      const uint32_t j = idx[k];
+      acc += local_wall_term(ctx, c, I, ctx.separation(I.x, P.x[j]), P.m[j], I.v - P.v[j],
+                             ctx.gravity - P.a[j], nullptr);
+    }
     P.a[i] = acc + ctx.gravity;
   });
 }
@@ -167,6 +239,12 @@ void fluid_reaction(const Particles& P, const NeighborSearch& nb, const FluidCon
       const uint32_t i = idx[k];
       if (P.kind[i] != Kind::Fluid) continue;
       const FluidI I(P, ctx, i);
+      if (ctx.shell_wall && P.kind[j] == Kind::Shell) {  // the same background rule, per imaginary particle
+        Vec3 background = Vec3::Zero();
+        const Vec3 a = pair_acceleration(P, ctx, c, I, j, &background);
+        sum -= P.m[i] * (a + background);
+        continue;
+      }
       Vec3 a = pair_acceleration(P, ctx, c, I, j);
       // The background pressure is a device of the fluid's discretisation (it keeps the fluid's pressure
       // positive against the tensile instability), not a load on the body: a uniform pressure has no net

@@ -16,6 +16,7 @@
 #include "core/neighbors.hpp"
 #include "core/particles.hpp"
 #include "core/periodic.hpp"
+#include "fluid/shell_wall.hpp"
 
 namespace aortasph {
 
@@ -61,6 +62,8 @@ struct FluidContext {
   std::vector<double> p_over_rho2;  // p / rho^2
   std::vector<double> volume;       // m / rho
   Periodic periodic;                // periodic axes: pair separations are nearest images
+  // Shells seen as two-sided walls (fluid/shell_wall.hpp); null when the scene has no shell beside a fluid.
+  const ShellWall* shell_wall = nullptr;
   // x_i - x_j, or its nearest image along periodic axes.
   Vec3 separation(const Vec3& xi, const Vec3& xj) const {
     return periodic.any ? periodic.image(xi - xj) : Vec3(xi - xj);

@@ -1,0 +1,235 @@
+#include "boundary/shell_coupling.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/parallel.hpp"
+
+namespace aortasph {
+
+ShellCoupling::ShellCoupling(const Particles& P, const Shells& shells, double dx, double support,
+                             double rho_ref)
+    : active_(!shells.empty()), dx_(dx), patch2_(0.64 * dx * dx) {
+  wall_.dx = dx;
+  wall_.layers = static_cast<int>(std::floor(support / dx + 0.5));  // (k - 1/2) dx < support
+  ghost_rho_ = rho_ref;
+  // Edge particles: the first moment of the reference neighbourhood, sum_j W_ij (X_j - X_i) / sum_j W_ij,
+  // vanishes inside a sheet and is about dx / 2 at its edge; over 0.1 dx flags the two or three rows along
+  // every edge (only there is the exact patch test needed).
+  const std::size_t n = shells.size();
+  edge_.assign(n, 0);
+  std::vector<Vec3> X(n);
+  for (std::size_t s = 0; s < n; ++s) X[s] = shells.reference(s);
+  NeighborSearch nbs;
+  nbs.build(X, support);
+  const CubicSpline K(0.5 * support);
+  parallel_for(n, [&](std::size_t s) {
+    const uint16_t body = P.body[shells.at(s)];
+    Vec3 moment = Vec3::Zero();
+    double sum = 0.0;
+    for (uint32_t k = nbs.begin(s); k < nbs.end(s); ++k) {
+      const uint32_t t = nbs.index()[k];
+      if (P.body[shells.at(t)] != body) continue;
+      const double w = K.W((X[t] - X[s]).norm());
+      moment += w * (X[t] - X[s]);
+      sum += w;
+    }
+    edge_[s] = sum <= 0.0 || moment.norm() > 0.1 * dx * sum;
+  });
+  // A supported edge is sealed by the wall it is fixed to: only free edges count, and only beyond 1.5
+  // supports of every supported particle of the body.
+  std::vector<uint8_t> near_support(n, 0);
+  parallel_for(n, [&](std::size_t s) {
+    if (!edge_[s]) return;
+    const uint16_t body = P.body[shells.at(s)];
+    for (std::size_t t = 0; t < n; ++t)
+      if (shells.support(t) != 0 && P.body[shells.at(t)] == body &&
+          (X[t] - X[s]).squaredNorm() < 2.25 * support * support) {
+        near_support[s] = 1;
+        return;
+      }
+  });
+  for (std::size_t s = 0; s < n; ++s)
+    if (near_support[s]) edge_[s] = 0;
+}
+
+void ShellCoupling::on_build(const Particles& P, NeighborSearch& nb) {
+  if (!active_) return;
+  nb.enable_row_ends();
+  const std::size_t n = P.size();
+  std::vector<uint8_t> in_band(n, 0);
+  const auto& idx = nb.index();
+  parallel_for(n, [&](std::size_t i) {
+    if (P.kind[i] == Kind::Shell) {
+      in_band[i] = 1;
+      return;
+    }
+    for (uint32_t k = nb.begin(i); k < nb.full_end(i); ++k)
+      if (P.kind[idx[k]] == Kind::Shell) {
+        in_band[i] = 1;
+        return;
+      }
+  });
+  band_.clear();
+  band_of_.assign(n, -1);
+  saved_offset_.assign(1, 0);
+  saved_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!in_band[i]) continue;
+    band_of_[i] = static_cast<int32_t>(band_.size());
+    band_.push_back(static_cast<uint32_t>(i));
+    saved_.insert(saved_.end(), idx.begin() + nb.begin(i), idx.begin() + nb.full_end(i));
+    saved_offset_.push_back(static_cast<uint32_t>(saved_.size()));
+  }
+  labels_.assign(band_.size(), Labels{});
+}
+
+bool ShellCoupling::pierces(const Particles& P, const Periodic& per, uint32_t a, uint32_t b,
+                            uint16_t body) const {
+  const Vec3 ab = per.any ? per.image(P.x[b] - P.x[a]) : Vec3(P.x[b] - P.x[a]);
+  for (const uint32_t row : {a, b}) {
+    const int32_t r = band_of_[row];
+    if (r < 0) continue;
+    for (uint32_t k = saved_offset_[r]; k < saved_offset_[r + 1]; ++k) {
+      const uint32_t s = saved_[k];
+      if (P.kind[s] != Kind::Shell || P.body[s] != body) continue;
+      const Vec3& nrm = wall_.normal[s];
+      const Vec3 as = per.any ? per.image(P.x[a] - P.x[s]) : Vec3(P.x[a] - P.x[s]);
+      const double da = nrm.dot(as), db = nrm.dot(as + ab);
+      if (da * db >= 0.0) continue;
+      const Vec3 c = as + (da / (da - db)) * ab;  // where the segment meets s's tangent plane, from x_s
+      if (c.squaredNorm() < patch2_) return true;
+    }
+  }
+  return false;
+}
+
+bool ShellCoupling::blocked(const Particles& P, const Periodic& per, uint32_t a, uint32_t b) const {
+  const Kind ka = P.kind[a], kb = P.kind[b];
+  if (!fluid_like(ka) && !fluid_like(kb)) return false;
+  const int32_t ia = band_of_[a], ib = band_of_[b];
+  if (ia < 0 || ib < 0) return false;
+  const Labels& la = labels_[ia];
+  const Labels& lb = labels_[ib];
+  for (uint8_t p = 0; p < la.n; ++p) {
+    const Label& A = la.l[p];
+    if (kb == Kind::Shell && P.body[b] == A.body) continue;  // b's own sheet: its imaginary particles
+    for (uint8_t q = 0; q < lb.n; ++q) {
+      const Label& B = lb.l[q];
+      if (B.body != A.body || B.side == A.side) continue;
+      if (!A.edge && !B.edge) return true;
+      // The same order from either row, so that both rows of the pair decide alike.
+      if (pierces(P, per, std::min(a, b), std::max(a, b), A.body)) return true;
+    }
+  }
+  return false;
+}
+
+void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSearch& nb,
+                            const Periodic& per) {
+  if (!active_) return;
+  const std::size_t n = P.size();
+  wall_.normal.resize(n);
+  wall_.ghost_mass.resize(n);
+  parallel_for(shells.size(), [&](std::size_t s) {
+    const uint32_t i = shells.at(s);
+    wall_.normal[i] = shells.director(s);
+    wall_.ghost_mass[i] = ghost_rho_ * shells.area(s) * dx_;
+  });
+  // Rows as built, then the labels.
+  uint32_t* rows = nb.row_data();
+  parallel_for(band_.size(), [&](std::size_t r) {
+    const uint32_t i = band_[r];
+    std::copy(saved_.begin() + saved_offset_[r], saved_.begin() + saved_offset_[r + 1], rows + nb.begin(i));
+    nb.set_end(i, nb.full_end(i));
+    Labels L;
+    std::array<double, kLabels> best{};
+    const bool shell_i = P.kind[i] == Kind::Shell;
+    for (uint32_t k = saved_offset_[r]; k < saved_offset_[r + 1]; ++k) {
+      const uint32_t j = saved_[k];
+      if (P.kind[j] != Kind::Shell || (shell_i && P.body[j] == P.body[i])) continue;
+      const Vec3 d = per.any ? per.image(P.x[i] - P.x[j]) : Vec3(P.x[i] - P.x[j]);
+      const double d2 = d.squaredNorm();
+      int slot = -1;
+      for (int q = 0; q < L.n; ++q)
+        if (L.l[q].body == P.body[j]) slot = q;
+      if (slot < 0) {
+        if (L.n == kLabels) continue;  // more shell bodies than labels around one particle: ignored
+        slot = L.n++;
+        best[slot] = d2 + 1.0;
+        L.l[slot].body = P.body[j];
+      }
+      if (d2 < best[slot]) {
+        best[slot] = d2;
+        Label& l = L.l[slot];
+        l.nearest = j;
+        l.side = wall_.normal[j].dot(d) >= 0.0 ? 1 : -1;
+        l.edge = edge_[static_cast<std::size_t>(shells.slot(j))];
+      }
+    }
+    labels_[r] = L;
+  });
+  // Masks: each row partitioned into kept pairs, local walls and masked pairs, each in their built order. A
+  // fixed wall particle across a sheet from a fluid particle is a "local wall" for it (fluid/shell_wall.hpp:
+  // its pressure extrapolated from the fluid particle alone, not the wall's own value, which belongs to the
+  // other side), and the fluid particle is masked from the wall's row (so the wall's value is its own
+  // side's). Without the local walls, a fluid particle in the corner of a sheet and the wall it is
+  // attached to would lose the wall beyond the sheet's plane.
+  wall_.local_begin.assign(n, ShellWall::kNoLocal);
+  std::vector<uint32_t> masked(band_.size(), 0);
+  parallel_for_dynamic(band_.size(), [&](std::size_t r) {
+    const uint32_t a = band_[r];
+    uint32_t* row = rows + nb.begin(a);
+    const uint32_t len = nb.full_end(a) - nb.begin(a);
+    const bool fluid_a = fluid_like(P.kind[a]);
+    uint32_t kept = 0;
+    thread_local std::vector<uint32_t> local, tail;
+    local.clear();
+    tail.clear();
+    for (uint32_t k = 0; k < len; ++k) {
+      const uint32_t b = row[k];
+      if (!blocked(P, per, a, b))
+        row[kept++] = b;
+      else if (fluid_a && P.kind[b] == Kind::Wall)
+        local.push_back(b);
+      else
+        tail.push_back(b);
+    }
+    if (fluid_a) wall_.local_begin[a] = nb.begin(a) + kept;
+    std::copy(local.begin(), local.end(), row + kept);
+    std::copy(tail.begin(), tail.end(), row + kept + local.size());
+    nb.set_end(a, nb.begin(a) + kept + static_cast<uint32_t>(local.size()));
+    masked[r] = static_cast<uint32_t>(tail.size());
+  });
+  masked_ = 0;
+  for (const uint32_t m : masked) masked_ += m;
+}
+
+std::size_t ShellCoupling::guard(Particles& P, const Periodic& per) {
+  if (!active_) return 0;
+  std::vector<uint8_t> moved(band_.size(), 0);
+  parallel_for(band_.size(), [&](std::size_t r) {
+    const uint32_t a = band_[r];
+    if (P.kind[a] != Kind::Fluid) return;
+    const Labels& L = labels_[r];
+    for (uint8_t q = 0; q < L.n; ++q) {
+      const Label& l = L.l[q];
+      if (l.edge) continue;
+      const Vec3& nrm = wall_.normal[l.nearest];
+      const Vec3 d = per.any ? per.image(P.x[a] - P.x[l.nearest]) : Vec3(P.x[a] - P.x[l.nearest]);
+      const double s = nrm.dot(d);
+      if (s * l.side > 0.0) continue;
+      P.x[a] += (l.side * 0.1 * dx_ - s) * nrm;
+      if (per.any) per.wrap(P.x[a]);
+      const double vr = (P.v[a] - P.v[l.nearest]).dot(nrm);
+      if (vr * l.side < 0.0) P.v[a] -= vr * nrm;
+      moved[r] = 1;
+    }
+  });
+  std::size_t count = 0;
+  for (const uint8_t m : moved) count += m;
+  crossings_ += static_cast<long>(count);
+  return count;
+}
+
+}  // namespace aortasph

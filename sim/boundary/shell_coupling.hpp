@@ -1,0 +1,91 @@
+// Fluid on both sides of a one-layer shell (issue 16 item 3; docs/model.md, "Fluid on both sides of a
+// shell"). What the fluid's pair sums see of a shell is in fluid/shell_wall.hpp (imaginary wall particles on
+// the side away from each fluid particle). This file keeps the two sides apart:
+//
+//  1. Side labels. Every particle whose neighbour list holds shell particles (fluid, walls, other bodies,
+//     and shell particles with respect to OTHER shell bodies) gets, per shell body B near it, a label: the
+//     nearest particle s of B and the side sigma = sign(n_s . (x - x_s)); the label is "at an edge" when s
+//     lies on the sheet's free or supported edge.
+//  2. Masking. A pair (a, b) with a fluid particle in it is taken out of both neighbour lists for this step
+//     when it straddles a sheet: some body B labels a and b on opposite sides and, when both labels are
+//     interior, that is enough; near an edge the segment x_a -> x_b must also pierce B's sheet, i.e. cross
+//     the tangent plane of one of B's particles within 0.8 dx of it (a patch test, so that fluid passes
+//     round a free edge but not through the sheet next to it). A pair of a fluid particle and a shell
+//     particle of B is masked by the other bodies only (its own sheet is what its imaginary particles
+//     stand for). Shell-shell and solid-solid pairs are never masked (contact needs them). This is the
+//     "side masking" of /work/shared/reference/shell.md section 4, which SPHinXsys's one-sided coupling
+//     lacks. The masked pairs move to the tail of their rows (NeighborSearch::set_end): every loop of the
+//     step skips them, and the rows are restored from the lists' build before each step, so the result does
+//     not depend on the history of the masks (checkpoints restart bitwise).
+//  3. Guard. After the drift, a fluid particle whose interior label flipped has crossed the sheet between
+//     two particles: it is put back on its side, 0.1 dx off the tangent plane, its velocity relative to the
+//     sheet along the normal removed, and counted (crossings(); the count stays 0 in every shipped scene).
+//
+// Only the rows of particles near a shell are touched (the "band", found at each list build): the cost is
+// proportional to the sheet's area, not to the fluid's volume.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/neighbors.hpp"
+#include "core/particles.hpp"
+#include "core/periodic.hpp"
+#include "fluid/shell_wall.hpp"
+#include "solid/shell.hpp"
+
+namespace aortasph {
+
+class ShellCoupling {
+ public:
+  ShellCoupling() = default;
+  // Edge particles of every shell body from the reference configuration; rho_ref: the walls' reference
+  // density (the imaginary particles' mass), support: the fluid kernel's.
+  ShellCoupling(const Particles& P, const Shells& shells, double dx, double support, double rho_ref);
+
+  bool active() const { return active_; }
+  // After each list build: the band rows and a copy of their pairs as built.
+  void on_build(const Particles& P, NeighborSearch& nb);
+  // Before the fluid sums of a step: the imaginary particles' normals and masses, the side labels and the
+  // masks.
+  void prepare(const Particles& P, const Shells& shells, NeighborSearch& nb, const Periodic& per);
+  // After the drift: fluid particles that crossed a sheet are put back (see above). Returns how many.
+  std::size_t guard(Particles& P, const Periodic& per);
+
+  const ShellWall& wall() const { return wall_; }
+
+  long crossings() const { return crossings_; }
+  void set_crossings(long c) { crossings_ = c; }
+  std::size_t masked_pairs() const { return masked_; }
+
+ private:
+  struct Label {
+    uint32_t nearest = 0;  // particle index of the nearest particle of the body
+    uint16_t body = 0;
+    int8_t side = 0;  // +1 / -1
+    uint8_t edge = 0;
+  };
+  static constexpr int kLabels = 4;
+  struct Labels {
+    std::array<Label, kLabels> l;
+    uint8_t n = 0;
+  };
+
+  bool blocked(const Particles& P, const Periodic& per, uint32_t a, uint32_t b) const;
+  bool pierces(const Particles& P, const Periodic& per, uint32_t a, uint32_t b, uint16_t body) const;
+
+  bool active_ = false;
+  double dx_ = 0.0, patch2_ = 0.0, ghost_rho_ = 1000.0;
+  std::vector<uint8_t> edge_;  // by shell slot
+  ShellWall wall_;
+  // Band: rows holding a shell particle, their pairs as built (CSR) and their labels this step.
+  std::vector<uint32_t> band_;    // particle indices
+  std::vector<int32_t> band_of_;  // by particle: index into band_, or -1
+  std::vector<uint32_t> saved_offset_, saved_;
+  std::vector<Labels> labels_;
+  long crossings_ = 0;
+  std::size_t masked_ = 0;
+};
+
+}  // namespace aortasph
