@@ -39,15 +39,22 @@ ShellCoupling::ShellCoupling(const Particles& P, const Shells& shells, double dx
   // A supported edge is sealed by the wall it is fixed to: only free edges count, and only beyond 1.5
   // supports of every supported particle of the body.
   std::vector<uint8_t> near_support(n, 0);
+  NeighborSearch wide;
+  wide.build(X, 1.5 * support);
   parallel_for(n, [&](std::size_t s) {
     if (!edge_[s]) return;
+    if (shells.support(s) != 0) {
+      near_support[s] = 1;
+      return;
+    }
     const uint16_t body = P.body[shells.at(s)];
-    for (std::size_t t = 0; t < n; ++t)
-      if (shells.support(t) != 0 && P.body[shells.at(t)] == body &&
-          (X[t] - X[s]).squaredNorm() < 2.25 * support * support) {
+    for (uint32_t k = wide.begin(s); k < wide.end(s); ++k) {
+      const uint32_t t = wide.index()[k];
+      if (shells.support(t) != 0 && P.body[shells.at(t)] == body) {
         near_support[s] = 1;
         return;
       }
+    }
   });
   for (std::size_t s = 0; s < n; ++s)
     if (near_support[s]) edge_[s] = 0;
