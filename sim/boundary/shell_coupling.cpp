@@ -36,28 +36,6 @@ ShellCoupling::ShellCoupling(const Particles& P, const Shells& shells, double dx
     }
     edge_[s] = sum <= 0.0 || moment.norm() > 0.1 * dx * sum;
   });
-  // A supported edge is sealed by the wall it is fixed to: only free edges count, and only beyond 1.5
-  // supports of every supported particle of the body.
-  std::vector<uint8_t> near_support(n, 0);
-  NeighborSearch wide;
-  wide.build(X, 1.5 * support);
-  parallel_for(n, [&](std::size_t s) {
-    if (!edge_[s]) return;
-    if (shells.support(s) != 0) {
-      near_support[s] = 1;
-      return;
-    }
-    const uint16_t body = P.body[shells.at(s)];
-    for (uint32_t k = wide.begin(s); k < wide.end(s); ++k) {
-      const uint32_t t = wide.index()[k];
-      if (shells.support(t) != 0 && P.body[shells.at(t)] == body) {
-        near_support[s] = 1;
-        return;
-      }
-    }
-  });
-  for (std::size_t s = 0; s < n; ++s)
-    if (near_support[s]) edge_[s] = 0;
 }
 
 void ShellCoupling::on_build(const Particles& P, NeighborSearch& nb) {
@@ -91,24 +69,27 @@ void ShellCoupling::on_build(const Particles& P, NeighborSearch& nb) {
   labels_.assign(band_.size(), Labels{});
 }
 
-bool ShellCoupling::pierces(const Particles& P, const Periodic& per, uint32_t a, uint32_t b,
-                            uint16_t body) const {
-  const Vec3 ab = per.any ? per.image(P.x[b] - P.x[a]) : Vec3(P.x[b] - P.x[a]);
-  for (const uint32_t row : {a, b}) {
-    const int32_t r = band_of_[row];
-    if (r < 0) continue;
-    for (uint32_t k = saved_offset_[r]; k < saved_offset_[r + 1]; ++k) {
-      const uint32_t s = saved_[k];
-      if (P.kind[s] != Kind::Shell || P.body[s] != body) continue;
-      const Vec3& nrm = wall_.normal[s];
-      const Vec3 as = per.any ? per.image(P.x[a] - P.x[s]) : Vec3(P.x[a] - P.x[s]);
-      const double da = nrm.dot(as), db = nrm.dot(as + ab);
-      if (da * db >= 0.0) continue;
-      const Vec3 c = as + (da / (da - db)) * ab;  // where the segment meets s's tangent plane, from x_s
-      if (c.squaredNorm() < patch2_) return true;
-    }
+bool ShellCoupling::segment_pierces(const Particles& P, const Periodic& per, const Vec3& xa, const Vec3& xb,
+                                    int32_t row, uint16_t body) const {
+  if (row < 0) return false;
+  const Vec3 ab = per.any ? per.image(xb - xa) : Vec3(xb - xa);
+  for (uint32_t k = saved_offset_[row]; k < saved_offset_[row + 1]; ++k) {
+    const uint32_t s = saved_[k];
+    if (P.kind[s] != Kind::Shell || P.body[s] != body) continue;
+    const Vec3& nrm = wall_.normal[s];
+    const Vec3 as = per.any ? per.image(xa - P.x[s]) : Vec3(xa - P.x[s]);
+    const double da = nrm.dot(as), db = nrm.dot(as + ab);
+    if (da * db >= 0.0) continue;
+    const Vec3 c = as + (da / (da - db)) * ab;  // where the segment meets s's tangent plane, from x_s
+    if (c.squaredNorm() < patch2_) return true;
   }
   return false;
+}
+
+bool ShellCoupling::pierces(const Particles& P, const Periodic& per, uint32_t a, uint32_t b,
+                            uint16_t body) const {
+  return segment_pierces(P, per, P.x[a], P.x[b], band_of_[a], body) ||
+         segment_pierces(P, per, P.x[a], P.x[b], band_of_[b], body);
 }
 
 bool ShellCoupling::blocked(const Particles& P, const Periodic& per, uint32_t a, uint32_t b) const {
@@ -124,7 +105,9 @@ bool ShellCoupling::blocked(const Particles& P, const Periodic& per, uint32_t a,
     for (uint8_t q = 0; q < lb.n; ++q) {
       const Label& B = lb.l[q];
       if (B.body != A.body || B.side == A.side) continue;
-      if (!A.edge && !B.edge) return true;
+      // Interior labels, or a wall (a wall particle is on one side of the sheet's plane, also where an edge
+      // of the sheet is fixed to the wall: its pressure belongs to that side).
+      if ((!A.edge && !B.edge) || ka == Kind::Wall || kb == Kind::Wall) return true;
       // The same order from either row, so that both rows of the pair decide alike.
       if (pierces(P, per, std::min(a, b), std::max(a, b), A.body)) return true;
     }
@@ -145,6 +128,7 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
   });
   // Rows as built, then the labels.
   uint32_t* rows = nb.row_data();
+  x_before_.resize(band_.size());
   parallel_for(band_.size(), [&](std::size_t r) {
     const uint32_t i = band_[r];
     std::copy(saved_.begin() + saved_offset_[r], saved_.begin() + saved_offset_[r + 1], rows + nb.begin(i));
@@ -175,6 +159,7 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
       }
     }
     labels_[r] = L;
+    x_before_[r] = P.x[i];
   });
   // Masks: each row partitioned into kept pairs, local walls and masked pairs, each in their built order. A
   // fixed wall particle across a sheet from a fluid particle is a "local wall" for it (fluid/shell_wall.hpp:
@@ -221,11 +206,12 @@ std::size_t ShellCoupling::guard(Particles& P, const Periodic& per) {
     const Labels& L = labels_[r];
     for (uint8_t q = 0; q < L.n; ++q) {
       const Label& l = L.l[q];
-      if (l.edge) continue;
       const Vec3& nrm = wall_.normal[l.nearest];
       const Vec3 d = per.any ? per.image(P.x[a] - P.x[l.nearest]) : Vec3(P.x[a] - P.x[l.nearest]);
       const double s = nrm.dot(d);
       if (s * l.side > 0.0) continue;
+      // Near a free edge only a path through the sheet counts (round the edge is allowed).
+      if (l.edge && !segment_pierces(P, per, x_before_[r], P.x[a], static_cast<int32_t>(r), l.body)) continue;
       P.x[a] += (l.side * 0.1 * dx_ - s) * nrm;
       if (per.any) per.wrap(P.x[a]);
       const double vr = (P.v[a] - P.v[l.nearest]).dot(nrm);

@@ -5,7 +5,7 @@
 //  1. Side labels. Every particle whose neighbour list holds shell particles (fluid, walls, other bodies,
 //     and shell particles with respect to OTHER shell bodies) gets, per shell body B near it, a label: the
 //     nearest particle s of B and the side sigma = sign(n_s . (x - x_s)); the label is "at an edge" when s
-//     lies on the sheet's free or supported edge.
+//     lies in the two or three rows along an edge of the sheet (free or supported).
 //  2. Masking. A pair (a, b) with a fluid particle in it is taken out of both neighbour lists for this step
 //     when it straddles a sheet: some body B labels a and b on opposite sides and, when both labels are
 //     interior, that is enough; near an edge the segment x_a -> x_b must also pierce B's sheet, i.e. cross
@@ -18,8 +18,9 @@
 //     step skips them, and the rows are restored from the lists' build before each step, so the result does
 //     not depend on the history of the masks (checkpoints restart bitwise).
 //  3. Guard. After the drift, a fluid particle whose interior label flipped has crossed the sheet between
-//     two particles: it is put back on its side, 0.1 dx off the tangent plane, its velocity relative to the
-//     sheet along the normal removed, and counted (crossings(); the count stays 0 in every shipped scene).
+//     two particles (near a free edge: whose path over the step pierced the sheet): it is put back on its
+//     side, 0.1 dx off the tangent plane, its velocity relative to the sheet along the normal removed, and
+//     counted (crossings(); the count stays 0 in every shipped scene).
 //
 // Only the rows of particles near a shell are touched (the "band", found at each list build): the cost is
 // proportional to the sheet's area, not to the fluid's volume.
@@ -74,6 +75,9 @@ class ShellCoupling {
 
   bool blocked(const Particles& P, const Periodic& per, uint32_t a, uint32_t b) const;
   bool pierces(const Particles& P, const Periodic& per, uint32_t a, uint32_t b, uint16_t body) const;
+  // Whether the segment xa -> xb crosses the sheet of `body` near the shell particles of band row `row`.
+  bool segment_pierces(const Particles& P, const Periodic& per, const Vec3& xa, const Vec3& xb, int32_t row,
+                       uint16_t body) const;
 
   bool active_ = false;
   double dx_ = 0.0, patch2_ = 0.0, ghost_rho_ = 1000.0;
@@ -84,6 +88,7 @@ class ShellCoupling {
   std::vector<int32_t> band_of_;  // by particle: index into band_, or -1
   std::vector<uint32_t> saved_offset_, saved_;
   std::vector<Labels> labels_;
+  std::vector<Vec3> x_before_;  // band rows' positions at prepare() (the guard's path near free edges)
   long crossings_ = 0;
   std::size_t masked_ = 0;
 };
