@@ -327,10 +327,13 @@ void World::build_lists() {
 void World::step(double dt) {
   update_neighbors();
   FluidContext& ctx = ctx_;
-  // Shells between fluids: pairs across a sheet masked, imaginary wall particles placed.
-  if (coupling_.active()) coupling_.prepare(P_, shells_, nb_, ctx.periodic);
-
   auto t0 = Clock::now();
+  // Shells between fluids: pairs across a sheet masked, imaginary wall particles placed (timed as boundary).
+  if (coupling_.active()) {
+    coupling_.prepare(P_, shells_, nb_, ctx.periodic);
+    profile_.boundary += seconds_since(t0);
+    t0 = Clock::now();
+  }
   fluid_density_summation(P_, nb_, ctx);  // eq. (11), where a material asks for it
   fluid_pair_terms(P_, ctx);
   fluid_density_rate(P_, nb_, ctx);  // eq. (12) + diffusion, elsewhere
