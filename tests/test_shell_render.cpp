@@ -112,7 +112,7 @@ TEST_CASE("shell sheets: a lattice gives 2 (n-1)(m-1) triangles, no edge above 1
           "[shell_render]") {
   const double dx = 0.01;
   std::vector<Vec3> X, N;
-  for (const auto [nx, ny] : {std::pair{2, 2}, std::pair{7, 4}, std::pair{13, 9}}) {
+  for (const auto& [nx, ny] : {std::pair{2, 2}, std::pair{7, 4}, std::pair{13, 9}}) {
     lattice(nx, ny, dx, X, N);
     const auto T = triangulate_sheet(X, N, 1.5 * dx);
     CHECK(T.size() == static_cast<std::size_t>(2 * (nx - 1) * (ny - 1)));
