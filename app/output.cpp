@@ -108,9 +108,15 @@ void VtkWriter::write(const World& world, int frame) {
   std::ofstream f(path, std::ios::trunc);
   if (!f) throw InputError(path.string() + ": cannot open for writing");
   const std::size_t n = P.size();
+  // Shell sheets (sim/solid/shell_mesh.hpp) as polygons through the shell particles, so ParaView shows a
+  // surface; by particle index now.
+  const Shells& shells = world.shells();
+  std::vector<std::array<uint32_t, 3>> polys;
+  for (const auto& t : world.shell_sheets().triangles())
+    polys.push_back({shells.at(t[0]), shells.at(t[1]), shells.at(t[2])});
   f << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
     << "<PolyData>\n<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"" << n
-    << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n";
+    << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"" << polys.size() << "\">\n";
   f << std::setprecision(9);
   f << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
   for (std::size_t i = 0; i < n; ++i) f << P.x[i].x() << ' ' << P.x[i].y() << ' ' << P.x[i].z() << '\n';
@@ -125,18 +131,22 @@ void VtkWriter::write(const World& world, int frame) {
   for (std::size_t i = 0; i < n; ++i) f << P.body[i] << '\n';
   f << "</DataArray>\n<DataArray type=\"Int32\" Name=\"id\" format=\"ascii\">\n";
   for (std::size_t i = 0; i < n; ++i) f << P.id[i] << '\n';
-  // Shells (sim/solid/shell.hpp): the director (the through-thickness direction) and the thickness of each
-  // shell particle; zero for the others.
+  // Shells (sim/solid/shell.hpp): the director (the through-thickness direction), the mid-surface normal and
+  // the thickness of each shell particle; zero for the others.
   if (const Shells& sh = world.shells(); !sh.empty()) {
-    std::vector<Vec3> d(n, Vec3::Zero());
+    std::vector<Vec3> d(n, Vec3::Zero()), nrm(n, Vec3::Zero());
     std::vector<double> t(n, 0.0);
     for (std::size_t s = 0; s < sh.size(); ++s) {
       d[sh.at(s)] = sh.director(s);
+      nrm[sh.at(s)] = sh.normal(s);
       t[sh.at(s)] = sh.thickness(s);
     }
     f << "</DataArray>\n<DataArray type=\"Float64\" Name=\"director\" NumberOfComponents=\"3\" "
          "format=\"ascii\">\n";
     for (std::size_t i = 0; i < n; ++i) f << d[i].x() << ' ' << d[i].y() << ' ' << d[i].z() << '\n';
+    f << "</DataArray>\n<DataArray type=\"Float64\" Name=\"normal\" NumberOfComponents=\"3\" "
+         "format=\"ascii\">\n";
+    for (std::size_t i = 0; i < n; ++i) f << nrm[i].x() << ' ' << nrm[i].y() << ' ' << nrm[i].z() << '\n';
     f << "</DataArray>\n<DataArray type=\"Float64\" Name=\"thickness\" format=\"ascii\">\n";
     for (std::size_t i = 0; i < n; ++i) f << t[i] << '\n';
   }
@@ -145,7 +155,15 @@ void VtkWriter::write(const World& world, int frame) {
   for (std::size_t i = 0; i < n; ++i) f << i << '\n';
   f << "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
   for (std::size_t i = 0; i < n; ++i) f << i + 1 << '\n';
-  f << "</DataArray>\n</Verts>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+  f << "</DataArray>\n</Verts>\n";
+  if (!polys.empty()) {
+    f << "<Polys>\n<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n";
+    for (const auto& t : polys) f << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+    f << "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
+    for (std::size_t k = 0; k < polys.size(); ++k) f << 3 * (k + 1) << '\n';
+    f << "</DataArray>\n</Polys>\n";
+  }
+  f << "</Piece>\n</PolyData>\n</VTKFile>\n";
   f.close();
   if (!f) throw InputError(path.string() + ": write failed (disk full?)");
   files_.emplace_back(world.time(), name);

@@ -39,6 +39,18 @@ struct SplatVertex {
   uint8_t color[4];
 };
 
+// One vertex of a shell sheet: 28 bytes.
+struct SheetVertex {
+  float position[3];
+  float normal[3];
+  uint8_t color[4];
+};
+
+// Shell bodies with a sheet are drawn as that sheet, not as particles, unless hidden.
+bool drawn_as_sheet(const BodyView& body) {
+  return !body.sheet.empty() && body.render != RenderMode::Hidden;
+}
+
 bool diverging(const std::string& colormap) {
   return colormap == "coolwarm";
 }
@@ -129,18 +141,25 @@ struct Renderer::Impl {
   RenderSettings settings;
   std::map<RangeKey, std::pair<double, double>> ranges;  // chosen at run time, kept for the run
   GlContext context;
-  GLuint splat_program = 0, mesh_program = 0;
+  GLuint splat_program = 0, mesh_program = 0, sheet_program = 0;
   GLuint splat_vao = 0, mesh_vao = 0, splat_vbo = 0, mesh_vbo = 0, mesh_ebo = 0;
+  GLuint sheet_vao = 0, sheet_vbo = 0, sheet_ebo = 0;
   GLuint ms_fbo = 0, ms_color = 0, ms_depth = 0, resolve_fbo = 0, resolve_color = 0;
   float max_point_size = 64.0f;
-  std::vector<SplatVertex> splats;  // reused between frames
-  std::vector<uint8_t> rows;        // read-back buffer, reused
+  std::vector<SplatVertex> splats;          // reused between frames
+  std::vector<SheetVertex> sheet_vertices;  // all sheets of a frame, reused
+  std::vector<std::array<uint32_t, 3>> sheet_triangles;
+  std::vector<std::pair<std::size_t, std::size_t>> sheet_ranges;  // per drawn sheet: first triangle, count
+  std::vector<uint8_t> sheet_clipped;                             // per drawn sheet
+  std::vector<uint8_t> rows;                                      // read-back buffer, reused
 
   explicit Impl(const RenderSettings& s) : settings(s) {
     splat_program = build_program("shaders/splat.vert.glsl", shaders::splat_vert_glsl,
                                   "shaders/splat.frag.glsl", shaders::splat_frag_glsl);
     mesh_program = build_program("shaders/mesh.vert.glsl", shaders::mesh_vert_glsl, "shaders/mesh.frag.glsl",
                                  shaders::mesh_frag_glsl);
+    sheet_program = build_program("shaders/sheet.vert.glsl", shaders::sheet_vert_glsl,
+                                  "shaders/sheet.frag.glsl", shaders::sheet_frag_glsl);
     GLfloat range_px[2] = {1, 64};
     glGetFloatv(GL_POINT_SIZE_RANGE, range_px);
     max_point_size = range_px[1];
@@ -163,6 +182,21 @@ struct Renderer::Impl {
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh_ebo);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
     glEnableVertexAttribArray(0);
+
+    glGenVertexArrays(1, &sheet_vao);
+    glGenBuffers(1, &sheet_vbo);
+    glGenBuffers(1, &sheet_ebo);
+    glBindVertexArray(sheet_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, sheet_vbo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, sheet_ebo);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(SheetVertex), nullptr);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(SheetVertex),
+                          reinterpret_cast<void*>(offsetof(SheetVertex, normal)));
+    glVertexAttribPointer(2, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(SheetVertex),
+                          reinterpret_cast<void*>(offsetof(SheetVertex, color)));
+    glEnableVertexAttribArray(0);
+    glEnableVertexAttribArray(1);
+    glEnableVertexAttribArray(2);
 
     const int w = settings.width, h = settings.height;
     GLint max_samples = 1;
@@ -203,10 +237,11 @@ struct Renderer::Impl {
     }
     glDeleteProgram(splat_program);
     glDeleteProgram(mesh_program);
-    const GLuint buffers[] = {splat_vbo, mesh_vbo, mesh_ebo};
-    glDeleteBuffers(3, buffers);
-    const GLuint vaos[] = {splat_vao, mesh_vao};
-    glDeleteVertexArrays(2, vaos);
+    glDeleteProgram(sheet_program);
+    const GLuint buffers[] = {splat_vbo, mesh_vbo, mesh_ebo, sheet_vbo, sheet_ebo};
+    glDeleteBuffers(5, buffers);
+    const GLuint vaos[] = {splat_vao, mesh_vao, sheet_vao};
+    glDeleteVertexArrays(3, vaos);
     const GLuint fbos[] = {ms_fbo, resolve_fbo};
     glDeleteFramebuffers(2, fbos);
     const GLuint rbs[] = {ms_color, ms_depth, resolve_color};
@@ -241,7 +276,8 @@ struct Renderer::Impl {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (size_t i = 0; i < snap.size(); ++i) {
       const int b = snap.body[i];
-      if (b >= static_cast<int>(snap.bodies.size()) || snap.bodies[b].render != RenderMode::Particles ||
+      if (b >= static_cast<int>(snap.bodies.size()) ||
+          (snap.bodies[b].render != RenderMode::Particles && !drawn_as_sheet(snap.bodies[b])) ||
           look.hides(b))
         continue;
       const double v = field->values[i];
@@ -276,7 +312,8 @@ struct Renderer::Impl {
     std::vector<uint8_t> draw(nb, 0), clipped(nb, 0);
     std::vector<std::array<uint8_t, 4>> body_color(nb);
     for (size_t b = 0; b < nb; ++b) {
-      draw[b] = snap.bodies[b].render == RenderMode::Particles && !look.hides(b);
+      draw[b] =
+          snap.bodies[b].render == RenderMode::Particles && snap.bodies[b].sheet.empty() && !look.hides(b);
       for (int c = 0; c < 3; ++c)
         body_color[b][c] =
             static_cast<uint8_t>(std::lround(std::clamp(snap.bodies[b].color[c], 0.0f, 1.0f) * 255.0f));
@@ -322,6 +359,81 @@ struct Renderer::Impl {
     }
   }
 
+  // The sheets of the shell bodies the camera draws: each sheet's particles as vertices, with normals summed
+  // from the triangles at the current positions (area weighted) and the colour of their particle.
+  void build_sheets(const Snapshot& snap, const Look& look, const SnapshotField* field) {
+    sheet_vertices.clear();
+    sheet_triangles.clear();
+    sheet_ranges.clear();
+    sheet_clipped.clear();
+    const size_t n = snap.size();
+    const auto range = range_of(look);
+    std::optional<Colormap> colormap;
+    if (field) colormap.emplace(look.colormap);
+    const double lo = range ? range->first : 0.0;
+    const double inv = range ? 1.0 / (range->second - range->first) : 0.0;
+    std::vector<uint32_t> local(n, std::numeric_limits<uint32_t>::max());
+    std::vector<glm::vec3> normal;
+    for (size_t b = 0; b < snap.bodies.size(); ++b) {
+      const BodyView& body = snap.bodies[b];
+      if (!drawn_as_sheet(body) || look.hides(b)) continue;
+      const size_t first_vertex = sheet_vertices.size(), first_triangle = sheet_triangles.size();
+      std::array<uint8_t, 4> body_color;
+      for (int c = 0; c < 3; ++c)
+        body_color[c] = static_cast<uint8_t>(std::lround(std::clamp(body.color[c], 0.0f, 1.0f) * 255.0f));
+      body_color[3] = 255;
+      for (const auto& t : body.sheet) {
+        std::array<uint32_t, 3> lt;
+        for (int c = 0; c < 3; ++c) {
+          const uint32_t i = t[c];
+          if (i >= n || snap.body[i] != b)
+            throw RenderError("snapshot: sheet of body \"" + body.name + "\" indexes particle " +
+                              std::to_string(i) + ", not one of its own");
+          if (local[i] == std::numeric_limits<uint32_t>::max()) {
+            local[i] = static_cast<uint32_t>(sheet_vertices.size() - first_vertex);
+            SheetVertex v{};
+            std::memcpy(v.position, &snap.position[3 * i], sizeof v.position);
+            if (field) {
+              const auto col = (*colormap)((field->values[i] - lo) * inv);
+              v.color[0] = col[0];
+              v.color[1] = col[1];
+              v.color[2] = col[2];
+              v.color[3] = 255;
+            } else {
+              std::memcpy(v.color, body_color.data(), 4);
+            }
+            sheet_vertices.push_back(v);
+          }
+          lt[c] = local[i];
+        }
+        sheet_triangles.push_back(lt);
+      }
+      // Area-weighted vertex normals (the cross product's length is twice the area).
+      normal.assign(sheet_vertices.size() - first_vertex, glm::vec3(0.0f));
+      for (size_t k = first_triangle; k < sheet_triangles.size(); ++k) {
+        const auto& t = sheet_triangles[k];
+        const glm::vec3 a = glm::make_vec3(sheet_vertices[first_vertex + t[0]].position);
+        const glm::vec3 bb = glm::make_vec3(sheet_vertices[first_vertex + t[1]].position);
+        const glm::vec3 c = glm::make_vec3(sheet_vertices[first_vertex + t[2]].position);
+        const glm::vec3 fn = glm::cross(bb - a, c - a);
+        for (uint32_t v : t) normal[v] += fn;
+      }
+      for (size_t v = 0; v < normal.size(); ++v) {
+        const float len = glm::length(normal[v]);
+        const glm::vec3 nv = len > 0.0f ? normal[v] / len : glm::vec3(0.0f, 0.0f, 1.0f);
+        std::memcpy(sheet_vertices[first_vertex + v].normal, glm::value_ptr(nv), sizeof(float) * 3);
+      }
+      // Vertex indices of this sheet into the shared vertex array; reset the map for the next body.
+      for (size_t k = first_triangle; k < sheet_triangles.size(); ++k)
+        for (uint32_t& v : sheet_triangles[k]) v += static_cast<uint32_t>(first_vertex);
+      for (const auto& t : body.sheet)
+        for (uint32_t i : t) local[i] = std::numeric_limits<uint32_t>::max();
+      sheet_ranges.emplace_back(first_triangle, sheet_triangles.size() - first_triangle);
+      sheet_clipped.push_back(look.clip && std::count(look.clip->bodies.begin(), look.clip->bodies.end(),
+                                                      static_cast<int>(b)) > 0);
+    }
+  }
+
   // Near and far planes enclosing everything drawn, so depth precision follows the scene's scale.
   std::pair<double, double> depth_bounds(const Snapshot& snap, const Look& look, const glm::dvec3& eye,
                                          const glm::dvec3& dir) {
@@ -332,6 +444,7 @@ struct Renderer::Impl {
       dmax = std::max(dmax, d);
     };
     for (const SplatVertex& v : splats) add(v.position);
+    for (const SheetVertex& v : sheet_vertices) add(v.position);
     for (size_t b = 0; b < snap.bodies.size(); ++b)
       if (snap.bodies[b].render == RenderMode::Surface && !look.hides(b))
         for (const auto& p : snap.bodies[b].mesh.vertices) add(p.data());
@@ -350,6 +463,7 @@ struct Renderer::Impl {
     check_sizes(snap, field);
     choose_range(snap, look, field);
     build_splats(snap, look, field);
+    build_sheets(snap, look, field);
 
     const int w = settings.width, h = settings.height;
     const glm::dvec3 eye = to_glm(camera.eye), target = to_glm(camera.target);
@@ -392,6 +506,43 @@ struct Renderer::Impl {
       glEnable(GL_SAMPLE_ALPHA_TO_COVERAGE);
       glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(splats.size()));
       glDisable(GL_SAMPLE_ALPHA_TO_COVERAGE);
+    }
+
+    // Opaque shell sheets, two-sided lit, with depth writes like the splats.
+    if (!sheet_triangles.empty()) {
+      glUseProgram(sheet_program);
+      glUniformMatrix4fv(glGetUniformLocation(sheet_program, "u_view"), 1, GL_FALSE, glm::value_ptr(view));
+      glUniformMatrix4fv(glGetUniformLocation(sheet_program, "u_proj"), 1, GL_FALSE, glm::value_ptr(proj));
+      glUniform3fv(glGetUniformLocation(sheet_program, "u_light_dir"), 1, light);
+      glUniform1f(glGetUniformLocation(sheet_program, "u_ambient"), Lighting::kAmbient);
+      glUniform1f(glGetUniformLocation(sheet_program, "u_diffuse"), Lighting::kDiffuse);
+      glUniform1f(glGetUniformLocation(sheet_program, "u_specular"), Lighting::kSpecular);
+      glUniform1f(glGetUniformLocation(sheet_program, "u_shininess"), Lighting::kShininess);
+      glm::vec4 plane(0.0f);
+      if (look.clip) {
+        const glm::dvec3 cn = glm::normalize(to_glm(look.clip->normal));
+        plane = glm::vec4(glm::vec3(cn), static_cast<float>(-glm::dot(cn, to_glm(look.clip->point))));
+      }
+      glUniform4fv(glGetUniformLocation(sheet_program, "u_clip_plane"), 1, glm::value_ptr(plane));
+      glBindVertexArray(sheet_vao);
+      glBindBuffer(GL_ARRAY_BUFFER, sheet_vbo);
+      glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(sheet_vertices.size() * sizeof(SheetVertex)),
+                   sheet_vertices.data(), GL_STREAM_DRAW);
+      glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+                   static_cast<GLsizeiptr>(sheet_triangles.size() * sizeof(sheet_triangles[0])),
+                   sheet_triangles.data(), GL_STREAM_DRAW);
+      glDepthMask(GL_TRUE);
+      glDisable(GL_BLEND);
+      glDisable(GL_CULL_FACE);
+      for (size_t k = 0; k < sheet_ranges.size(); ++k) {
+        if (sheet_clipped[k])
+          glEnable(GL_CLIP_DISTANCE0);
+        else
+          glDisable(GL_CLIP_DISTANCE0);
+        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * sheet_ranges[k].second), GL_UNSIGNED_INT,
+                       reinterpret_cast<void*>(3 * sizeof(uint32_t) * sheet_ranges[k].first));
+      }
+      glDisable(GL_CLIP_DISTANCE0);
     }
 
     // Translucent surfaces after the opaque splats, without depth writes, so particles behind a wall show

@@ -1,13 +1,14 @@
 // Offscreen renderer: draws a Snapshot for a Camera into an RGB8 image with OSMesa (llvmpipe).
 //
 // Particles are lit sphere impostors (GL_POINTS, radius = spacing / 2, true depth); bodies with
-// render == Surface are drawn as their translucent, two-sided lit mesh instead of their particles; Hidden
-// bodies, and the bodies a camera hides, are not drawn. Colour is the body colour (color_by == "material")
-// or the snapshot's field through the colormap, with one range for the whole run. The clip plane removes
-// the +normal half of the listed bodies. Each camera may override color_by, colormap, range, hide and clip
-// (scene.hpp Camera; RenderSettings::*_of say what applies). Anti-aliasing: a 4x multisampled framebuffer
-// with alpha-to-coverage on the splat rims (smooth silhouettes without shading every sample; llvmpipe offers
-// at most 4 samples).
+// render == Surface are drawn as their translucent, two-sided lit mesh instead of their particles; shell
+// bodies with a sheet (BodyView::sheet) as that opaque, smooth, two-sided lit sheet through their particles,
+// coloured per vertex; Hidden bodies, and the bodies a camera hides, are not drawn. Colour is the body colour
+// (color_by == "material") or the snapshot's field through the colormap, with one range for the whole run.
+// The clip plane removes the +normal half of the listed bodies. Each camera may override color_by, colormap,
+// range, hide and clip (scene.hpp Camera; RenderSettings::*_of say what applies). Anti-aliasing: a 4x
+// multisampled framebuffer with alpha-to-coverage on the splat rims (smooth silhouettes without shading every
+// sample; llvmpipe offers at most 4 samples).
 #pragma once
 
 #include <memory>

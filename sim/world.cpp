@@ -225,6 +225,11 @@ World::World(const Scene& scene)
       if (P_.id[i] < shell_seed.size()) by_index[i] = shell_seed[P_.id[i]];
     shells_ = Shells(P_, scene_.materials, kernel_, by_index);
     shells_.update(P_);
+    {  // the sheets drawn and written for the shell bodies: edges up to 1.5 dx (solid/shell_mesh.hpp)
+      std::vector<uint16_t> body_of(shells_.size());
+      for (std::size_t s = 0; s < shells_.size(); ++s) body_of[s] = P_.body[shells_.at(s)];
+      sheets_ = ShellSheets(shells_, body_of, 1.5 * dx);
+    }
     if (have_fluid) {  // fluid on either side of a sheet (sim/boundary/shell_coupling.hpp)
       coupling_ = ShellCoupling(P_, shells_, dx, kernel_.support, wall_ref_.rho0);
       ctx_.shell_wall = &coupling_.wall();
@@ -856,6 +861,11 @@ Snapshot World::snapshot(const std::vector<std::string>& fields, int frame) cons
     view.mesh = bodies_[b].mesh;  // fixed walls: the mesh of t = 0 is the mesh now
     s.bodies.push_back(std::move(view));
   }
+  // Shell bodies: their sheet, by the particles' indices now.
+  const auto& tri = sheets_.triangles();
+  for (std::size_t t = 0; t < tri.size(); ++t)
+    s.bodies[sheets_.body()[t]].sheet.push_back(
+        {shells_.at(tri[t][0]), shells_.at(tri[t][1]), shells_.at(tri[t][2])});
   return s;
 }
 

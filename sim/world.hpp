@@ -21,6 +21,7 @@
 #include "rigid/rigid_body.hpp"
 #include "scene.hpp"
 #include "solid/shell.hpp"
+#include "solid/shell_mesh.hpp"
 #include "solid/solid_tlsph.hpp"
 
 namespace aortasph {
@@ -134,6 +135,8 @@ class World {
     return s >= 0 ? solids_.mass(static_cast<std::size_t>(s)) : P_.m[i];
   }
   const Shells& shells() const { return shells_; }
+  // The shell bodies' sheets: triangles by shell slot, built once at t = 0 (solid/shell_mesh.hpp).
+  const ShellSheets& shell_sheets() const { return sheets_; }
   // Fluid on both sides of the shells (sim/boundary/shell_coupling.hpp): fluid particles put back on their
   // side of a sheet since t = 0 (0 when the coupling holds), and the pairs masked in the last step.
   long shell_crossings() const { return coupling_.crossings(); }
@@ -197,6 +200,7 @@ class World {
   std::vector<RigidBody> rigid_;
   Solids solids_;
   Shells shells_;
+  ShellSheets sheets_;      // the shells' triangulated mid-surfaces (render, VTK)
   ShellCoupling coupling_;  // active when a scene has shells and a fluid
   OpenBoundaries open_;     // inflows and outflows; their counters are plain values (OpenBoundaryState)
   ContactParams contact_;

@@ -24,6 +24,9 @@ struct BodyView {
   std::array<float, 3> color = {0.2f, 0.4f, 0.9f};  // rgb 0..1, from the scene or a default per material
   RenderMode render = RenderMode::Particles;
   SurfaceMesh mesh;  // in world coordinates at this snapshot's time (may be empty)
+  // Shell bodies: triangles through the body's particles (indices into Snapshot::position), oriented along
+  // the shell normals; drawn as a lit, two-sided, opaque sheet instead of the particles (may be empty).
+  std::vector<std::array<uint32_t, 3>> sheet;
 };
 
 // One per-particle field a camera colours by.
