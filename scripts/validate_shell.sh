@@ -3,7 +3,9 @@
 #   - the classic clamped circular plate (scenes/shell_plate.json: a = 40 in, t = 1 in, p = 6 psi) at dx = 4t, 2t,
 #     t: centre deflection against p a^4 / (64 D) = 2.2189 mm;
 #   - the roll-up of a cantilever strip under an end moment 2 pi E I / L, and the Scordelis-Lo roof
-#     (tests/test_shell.cpp, hidden tag [.shell-validation]).
+#     (tests/test_shell.cpp, hidden tag [.shell-validation]);
+#   - a water column on a clamped square plate (one side) and a plate window between two columns (both
+#     sides) against the clamped-plate formula (tests/test_shell_fluid.cpp, the same hidden tag).
 # Usage: scripts/validate_shell.sh   (BUILD_DIR=build, THREADS=1, OUT=out/validate_shell)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -100,7 +100,7 @@ std::size_t wrong_side(const World& w, int body, bool above) {
 
 }  // namespace
 
-TEST_CASE("shell-fluid: a clamped stiff sheet holds a 10 kPa difference without a leak", "[shell_fluid]") {
+TEST_CASE("shell-fluid: a clamped stiff sheet holds a 10 kPa difference without a leak", "[shell_fluid][long]") {
   // 1.02 m of water over a fixed sheet (rho g h = 10 kPa), a closed chamber of water below it. What is tested
   // is the fluid's side of the coupling: the column stands on the sheet as on a wall, and nothing of it, mass
   // or pressure, reaches the chamber.
@@ -185,8 +185,9 @@ double settled_deflection(World& world, const Vec3& x, const Vec3& axis, double 
 
 }  // namespace
 
+// Validation-size runs (17 s and 26 s on 2 threads): hidden, run by scripts/validate_shell.sh.
 TEST_CASE("shell-fluid: a water column on a clamped plate deflects it as the static load does (one side)",
-          "[shell_fluid][long]") {
+          "[.shell-validation][shell_fluid]") {
   // The plate is the floor of a square shaft: 13 x 13 particles at dx = 0.025 m, the edge rows clamped
   // (span a = 0.3 m between them, a / t = 12), t = dx, E = 6.8 MPa, rho 8000 kg/m^3 (a plate wave no faster
   // than the fluid's sound), under 0.5 m of water plus its own weight.
@@ -215,7 +216,7 @@ TEST_CASE("shell-fluid: a water column on a clamped plate deflects it as the sta
 }
 
 TEST_CASE("shell-fluid: a plate between two water columns deflects by the net load, nothing crosses",
-          "[shell_fluid][long]") {
+          "[.shell-validation][shell_fluid]") {
   // A tank divided at x = L by one sheet, fixed everywhere but a square window (13 x 13 particles at
   // dx = 0.025 m: span a = 0.3 m between the fixed rows, a / t = 12) whose middle is elastic; water 1.0 m
   // deep on the left, 0.7 m on the right. Both sides cover the window, so the net load on it is uniform,
@@ -297,7 +298,8 @@ TEST_CASE("shell-fluid: 1 and 2 threads give bitwise the same run, and a checkpo
   CHECK(a.shell_masked_pairs() == b.shell_masked_pairs());
 }
 
-TEST_CASE("shell-fluid: water passes round a free edge, not through the sheet beside it", "[shell_fluid]") {
+TEST_CASE("shell-fluid: water passes round a free edge, not through the sheet beside it",
+          "[shell_fluid][long]") {
   // A fixed baffle (one sheet) divides a tank down to 3 dx above the floor; its lower edge is free. Water
   // 0.6 m deep on the left, 0.3 m on the right flows under the edge and the levels approach each other;
   // every particle that changes side does so below the edge.

@@ -36,6 +36,20 @@ ShellCoupling::ShellCoupling(const Particles& P, const Shells& shells, double dx
     }
     edge_[s] = sum <= 0.0 || moment.norm() > 0.1 * dx * sum;
   });
+  // Their reference neighbours and weights, for the current outward direction (prepare()).
+  edge_offset_.assign(1, 0);
+  for (std::size_t s = 0; s < n; ++s) {
+    if (!edge_[s]) continue;
+    const uint16_t body = P.body[shells.at(s)];
+    for (uint32_t k = nbs.begin(s); k < nbs.end(s); ++k) {
+      const uint32_t t = nbs.index()[k];
+      if (P.body[shells.at(t)] != body) continue;
+      edge_nbr_.push_back(t);
+      edge_w_.push_back(K.W((X[t] - X[s]).norm()));
+    }
+    edge_slot_.push_back(static_cast<uint32_t>(s));
+    edge_offset_.push_back(static_cast<uint32_t>(edge_nbr_.size()));
+  }
 }
 
 void ShellCoupling::on_build(const Particles& P, NeighborSearch& nb) {
@@ -81,7 +95,8 @@ bool ShellCoupling::segment_pierces(const Particles& P, const Periodic& per, con
     const double da = nrm.dot(as), db = nrm.dot(as + ab);
     if (da * db >= 0.0) continue;
     const Vec3 c = as + (da / (da - db)) * ab;  // where the segment meets s's tangent plane, from x_s
-    if (c.squaredNorm() < patch2_) return true;
+    // Near an edge the patch stops half a spacing outward of the particle (where the sheet ends).
+    if (c.squaredNorm() < patch2_ && c.dot(edge_out_[s]) < 0.5 * dx_) return true;
   }
   return false;
 }
@@ -125,6 +140,19 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
     const uint32_t i = shells.at(s);
     wall_.normal[i] = shells.director(s);
     wall_.ghost_mass[i] = ghost_rho_ * shells.area(s) * dx_;
+  });
+  // Edge particles: the current outward direction in the tangent plane, minus the first moment of the
+  // reference neighbours at their current positions.
+  edge_out_.assign(n, Vec3::Zero());
+  parallel_for(edge_slot_.size(), [&](std::size_t e) {
+    const uint32_t i = shells.at(edge_slot_[e]);
+    Vec3 m = Vec3::Zero();
+    for (uint32_t k = edge_offset_[e]; k < edge_offset_[e + 1]; ++k)
+      m += edge_w_[k] * (P.x[shells.at(edge_nbr_[k])] - P.x[i]);
+    const Vec3& nrm = wall_.normal[i];
+    m -= m.dot(nrm) * nrm;
+    const double len = m.norm();
+    if (len > 0.0) edge_out_[i] = -m / len;
   });
   // Rows as built, then the labels.
   uint32_t* rows = nb.row_data();

@@ -9,8 +9,9 @@
 //  2. Masking. A pair (a, b) with a fluid particle in it is taken out of both neighbour lists for this step
 //     when it straddles a sheet: some body B labels a and b on opposite sides and, when both labels are
 //     interior, that is enough; near an edge the segment x_a -> x_b must also pierce B's sheet, i.e. cross
-//     the tangent plane of one of B's particles within 0.8 dx of it (a patch test, so that fluid passes
-//     round a free edge but not through the sheet next to it). A pair of a fluid particle and a shell
+//     the tangent plane of one of B's particles within 0.8 dx of it and, for a particle near an edge, no
+//     more than dx / 2 outward of it (a patch test, so that fluid passes round a free edge but not through
+//     the sheet next to it). A pair of a fluid particle and a shell
 //     particle of B is masked by the other bodies only (its own sheet is what its imaginary particles
 //     stand for). Shell-shell and solid-solid pairs are never masked (contact needs them). This is the
 //     "side masking" of /work/shared/reference/shell.md section 4, which SPHinXsys's one-sided coupling
@@ -82,6 +83,11 @@ class ShellCoupling {
   bool active_ = false;
   double dx_ = 0.0, patch2_ = 0.0, ghost_rho_ = 1000.0;
   std::vector<uint8_t> edge_;  // by shell slot
+  // Edge particles (slots), their reference neighbours (slots) with kernel weights (CSR), and by particle
+  // index the current outward in-plane direction of an edge particle (zero elsewhere).
+  std::vector<uint32_t> edge_slot_, edge_offset_, edge_nbr_;
+  std::vector<double> edge_w_;
+  std::vector<Vec3> edge_out_;
   ShellWall wall_;
   // Band: rows holding a shell particle, their pairs as built (CSR) and their labels this step.
   std::vector<uint32_t> band_;    // particle indices
