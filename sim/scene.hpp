@@ -180,6 +180,11 @@ struct Contact {
   double damping = 0.0;    // eta, eq. (24) [N s/m]
   double shear = 0.0;      // eq. (25) [N s/m]
   double friction = 0.5;   // Coulomb bound on the shear force
+  // Shell contact (sim/solid/shell_contact.hpp): barrier modulus K [Pa] (0: off), margin added to the
+  // half thicknesses [m] (< 0: half the mean thickness of the pair's shells), damping ratio.
+  double shell_stiffness = 0.0;
+  double shell_margin = -1.0;
+  double shell_damping = 0.5;
 };
 
 enum class ProbeType {

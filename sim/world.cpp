@@ -182,8 +182,12 @@ World::World(const Scene& scene)
     }
     bodies_.push_back(std::move(info));
   }
-  contact_ = ContactParams{scene_.contact.stiffness, scene_.contact.damping, scene_.contact.shear,
-                           scene_.contact.friction, dx};
+  contact_ = ContactParams{scene_.contact.stiffness,
+                           scene_.contact.damping,
+                           scene_.contact.shear,
+                           scene_.contact.friction,
+                           dx,
+                           false};
   if (P_.size() > std::numeric_limits<uint32_t>::max() / 4) throw SetupError("too many particles");
 
   // Bodies may touch but not overlap: particles of two bodies closer than half a spacing are an error (less
@@ -230,6 +234,10 @@ World::World(const Scene& scene)
       for (std::size_t s = 0; s < shells_.size(); ++s) body_of[s] = P_.body[shells_.at(s)];
       sheets_ = ShellSheets(shells_, body_of, 1.5 * dx);
     }
+    shell_contact_ = ShellContact(
+        {scene_.contact.shell_stiffness, scene_.contact.shell_margin, scene_.contact.shell_damping, dx},
+        kernel_.support);
+    contact_.skip_shells = shell_contact_.active();  // the shells' own contact replaces eqs. 23-25 there
     if (have_fluid) {  // fluid on either side of a sheet (sim/boundary/shell_coupling.hpp)
       coupling_ = ShellCoupling(P_, shells_, dx, kernel_.support, wall_ref_.rho0);
       ctx_.shell_wall = &coupling_.wall();
@@ -262,6 +270,10 @@ double World::stable_dt() const {
   if (!solids_.empty()) dt = std::min(dt, scene_.cfl * h / (solids_.max_wave_speed() + max_speed_));
   // Shells: the plate wave and the shear-rotary limit (Shells::stable_dt).
   if (!shells_.empty()) dt = std::min(dt, shells_.stable_dt(scene_.cfl, max_speed_));
+  // Shell contact: the contact spring and damper of the particles near contact (ShellContact::stable_dt),
+  // from the lists (stale right after particles were created or removed: then the bound waits a step).
+  if (shell_contact_.active() && lists_valid_)
+    dt = std::min(dt, shell_contact_.stable_dt(P_, nb_, shells_, ctx_.periodic, scene_.cfl));
   // Viscous diffusion limit (Morris, Fox & Zhu 1997, eq. 18): dt <= 0.125 h^2 / nu.
   if (max_nu_ > 0.0) dt = std::min(dt, 0.125 * h * h / max_nu_);
   // Contact spring: two particles of mass m on a spring k touch for about pi sqrt(m / 2k) (m: see the
@@ -438,6 +450,7 @@ void World::body_forces() {
   moment_.assign(n, Vec3::Zero());
   fluid_reaction(P_, nb_, ctx_, force_);
   contact_forces(P_, nb_, contact_, force_, moment_);
+  shell_contact_.add_forces(P_, nb_, shells_, ctx_.periodic, force_);  // sim/solid/shell_contact.hpp
 }
 
 // Elastic particles: internal forces (eqs. 14-18 with their stabilisers) plus what body_forces() found (the

@@ -22,6 +22,7 @@
 #include "scene.hpp"
 #include "solid/shell.hpp"
 #include "solid/shell_mesh.hpp"
+#include "solid/shell_contact.hpp"
 #include "solid/solid_tlsph.hpp"
 
 namespace aortasph {
@@ -204,6 +205,7 @@ class World {
   ShellCoupling coupling_;  // active when a scene has shells and a fluid
   OpenBoundaries open_;     // inflows and outflows; their counters are plain values (OpenBoundaryState)
   ContactParams contact_;
+  ShellContact shell_contact_;  // sheets against sheets and walls (active when contact.shell_stiffness > 0)
   double min_contact_mass_ = std::numeric_limits<double>::max();
   std::vector<Vec3> force_;   // per-particle force on body particles of the current step
   std::vector<Vec3> shift_;   // particle shifting of the current step (fluid/shifting.hpp); empty when off

@@ -38,6 +38,7 @@ void contact_forces(const Particles& P, const NeighborSearch& nb, const ContactP
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
       if (fluid_like(P.kind[j]) || P.body[j] == P.body[i]) continue;
+      if (c.skip_shells && (P.kind[i] == Kind::Shell || P.kind[j] == Kind::Shell)) continue;
       const Vec3 xij = P.x[i] - P.x[j];
       if (xij.squaredNorm() >= d2) continue;
       const Vec3 fij = contact_force(c, xij, P.v[i] - P.v[j]);

@@ -19,11 +19,12 @@
 namespace aortasph {
 
 struct ContactParams {
-  double k = 0.0;         // N/m
-  double eta = 0.0;       // N s/m
-  double shear = 0.0;     // N s/m
-  double friction = 0.5;  // Coulomb mu
-  double distance = 0.0;  // contact distance d [m]
+  double k = 0.0;            // N/m
+  double eta = 0.0;          // N s/m
+  double shear = 0.0;        // N s/m
+  double friction = 0.5;     // Coulomb mu
+  double distance = 0.0;     // contact distance d [m]
+  bool skip_shells = false;  // pairs with a shell particle: left to sim/solid/shell_contact.hpp
 };
 
 // Force of contact on particle i from particle j (x_ij = x_i - x_j). Antisymmetric: force(i,j) = -force(j,i)

@@ -1,0 +1,198 @@
+#include "solid/shell_contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "core/parallel.hpp"
+
+namespace aortasph {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// 2-D cubic spline (Monaghan & Lattanzio 1985), normalisation 10 / (7 pi h^2), support 2h.
+double W2(double r, double h) {
+  const double q = r / h;
+  const double alpha = 10.0 / (7.0 * std::numbers::pi * h * h);
+  if (q < 1.0) return alpha * (1.0 - 1.5 * q * q + 0.75 * q * q * q);
+  if (q < 2.0) {
+    const double t = 2.0 - q;
+    return alpha * 0.25 * t * t * t;
+  }
+  return 0.0;
+}
+
+bool volumetric(Kind k) {
+  return k == Kind::Wall || k == Kind::Elastic;
+}
+
+}  // namespace
+
+bool ShellContact::candidate(const Particles& P, const Shells& sh, std::size_t i, std::size_t j) const {
+  const Kind ki = P.kind[i], kj = P.kind[j];
+  const bool si = ki == Kind::Shell, sj = kj == Kind::Shell;
+  if (!si && !sj) return false;  // one shell at least
+  if (!(si || volumetric(ki)) || !(sj || volumetric(kj))) return false;
+  if (P.body[i] != P.body[j]) return true;
+  if (!si || !sj) return false;
+  // One sheet: only parts that were not neighbours in the reference (SPHinXsys ShellSelfContactRelation).
+  const long a = sh.slot(i), b = sh.slot(j);
+  if (a < 0 || b < 0) return false;
+  return (sh.reference(static_cast<std::size_t>(a)) - sh.reference(static_cast<std::size_t>(b))).norm() >
+         cutoff_;
+}
+
+// The pair (a, b), xab = x_a - x_b: force on a (b takes its negative), and the pair's stiffness, damper and
+// closing time near contact.
+ShellContact::Pair ShellContact::pair(const Particles& P, const Shells& sh, std::size_t a, std::size_t b,
+                                      const Vec3& xab) const {
+  Pair out;
+  out.gap = kInf;
+  const double dx = p_.dx;
+  const long sa = sh.slot(a), sb = sh.slot(b);
+  const bool a_shell = sa >= 0, b_shell = sb >= 0;
+  const auto slot = [](long s) { return static_cast<std::size_t>(s); };
+  const double ta = a_shell ? sh.thickness(slot(sa)) : 0.0, tb = b_shell ? sh.thickness(slot(sb)) : 0.0;
+  const double margin = p_.margin >= 0.0       ? p_.margin
+                        : (a_shell && b_shell) ? 0.25 * (ta + tb)
+                                               : 0.5 * (ta + tb);  // one of them is 0
+  const double dc = (a_shell ? 0.5 * ta : 0.5 * dx) + (b_shell ? 0.5 * tb : 0.5 * dx) + margin;
+  const double area_a = a_shell ? sh.area(slot(sa)) : dx * dx;
+  const double area_b = b_shell ? sh.area(slot(sb)) : dx * dx;
+  // Mass per area; a wall does not move (its share of the reduced mass is infinite).
+  const auto mu = [&](std::size_t i, long s) {
+    if (s >= 0) return sh.mass(slot(s)) / sh.area(slot(s));
+    return P.kind[i] == Kind::Wall ? kInf : P.m[i] / (dx * dx);
+  };
+  const double mua = mu(a, sa), mub = mu(b, sb);
+  const double mu_r = std::isinf(mua) ? mub : std::isinf(mub) ? mua : mua * mub / (mua + mub);
+  // Two sheets: the two planes share the pair by the squares of their gaps, half each for parallel sheets.
+  // Edge on (a free edge against a sheet's face) the partner sits in the edge particle's own plane (gap
+  // near 0), where that plane says nothing about the contact: its share goes to zero.
+  double share_b = 1.0, share_a = 1.0;  // of the term on b's plane, on a's plane
+  if (a_shell && b_shell) {
+    const double gb = xab.dot(sh.director(slot(sb))), ga = xab.dot(sh.director(slot(sa)));
+    const double sum = ga * ga + gb * gb;
+    share_b = sum > 0.0 ? gb * gb / sum : 0.5;
+    share_a = sum > 0.0 ? ga * ga / sum : 0.5;
+  }
+  double weight = 1.0;
+  const double K = p_.stiffness;
+  // Particle o against the tangent plane of shell particle q (slot s); d = x_o - x_q, v = v_o - v_q.
+  // Returns the force on o.
+  const auto term = [&](long s, const Vec3& d, const Vec3& v) -> Vec3 {
+    const Vec3& n = sh.director(slot(s));
+    const double sn = d.dot(n);
+    const double g = std::abs(sn);
+    if (g >= 2.0 * dc) return Vec3::Zero();
+    const double rho = std::sqrt(std::max(d.squaredNorm() - sn * sn, 0.0));
+    if (rho >= 2.0 * dx) return Vec3::Zero();
+    const double w = weight * area_a * area_b * W2(rho, dx);
+    const Vec3 e = sn >= 0.0 ? n : Vec3(-n);  // from q's plane towards o
+    const double rate = v.dot(e);             // d(gap)/dt
+    out.near = true;
+    out.gap = std::min(out.gap, g);
+    if (rate < 0.0) {
+      const double tc = g / -rate;
+      out.dt_close = out.dt_close > 0.0 ? std::min(out.dt_close, tc) : tc;
+    }
+    const double ge = std::max(g, 1e-3 * dc);
+    const double ka = g < dc ? K * dc / (ge * ge) : K / dc;  // stiffness per area [Pa/m]
+    const double ca = 2.0 * p_.damping * std::sqrt(ka * mu_r);
+    out.k += ka * w;
+    out.c += ca * w;
+    if (g >= dc) return Vec3::Zero();
+    const double p = std::max(K * (dc / ge - 1.0) - ca * rate, 0.0);  // barrier + damper, never pulling
+    return (p * w) * e;
+  };
+  const Vec3 vab = P.v[a] - P.v[b];
+  if (b_shell && share_b > 0.0) {  // a on b's plane
+    weight = share_b;
+    out.f_a += term(sb, xab, vab);
+  }
+  if (a_shell && share_a > 0.0) {  // b on a's plane
+    weight = share_a;
+    out.f_a -= term(sa, -xab, -vab);
+  }
+  return out;
+}
+
+template <class Visit>
+void ShellContact::visit_row(const Particles& P, const NeighborSearch& nb, const Shells& sh,
+                             const Periodic& per, std::size_t i, Visit&& visit) const {
+  const auto& idx = nb.index();
+  // The full row: the shell coupling may have cut masked fluid pairs off the end (NeighborSearch::end).
+  for (uint32_t k = nb.begin(i); k < nb.full_end(i); ++k) {
+    const uint32_t j = idx[k];
+    if (!candidate(P, sh, i, j)) continue;
+    const Vec3 xij = per.any ? per.image(P.x[i] - P.x[j]) : Vec3(P.x[i] - P.x[j]);
+    if (xij.squaredNorm() >= 9.0 * p_.dx * p_.dx) continue;
+    // One order for every pair (the lower id first), so the two particles see exactly opposite forces.
+    if (P.id[i] < P.id[j]) {
+      visit(pair(P, sh, i, j, xij), 1.0);
+    } else {
+      const Vec3 xji = per.any ? per.image(P.x[j] - P.x[i]) : Vec3(P.x[j] - P.x[i]);
+      visit(pair(P, sh, j, i, xji), -1.0);
+    }
+  }
+}
+
+void ShellContact::add_forces(const Particles& P, const NeighborSearch& nb, const Shells& sh,
+                              const Periodic& per, std::vector<Vec3>& f) const {
+  if (!active() || sh.empty() || nb.size() != P.size()) return;
+  parallel_for_dynamic(P.size(), [&](std::size_t i) {
+    if (P.kind[i] != Kind::Shell && P.kind[i] != Kind::Elastic) return;  // walls do not move
+    Vec3 sum = Vec3::Zero();
+    visit_row(P, nb, sh, per, i, [&](const Pair& pr, double sign) {
+      if (sign > 0.0)
+        sum += pr.f_a;
+      else
+        sum -= pr.f_a;
+    });
+    f[i] += sum;
+  });
+}
+
+double ShellContact::stable_dt(const Particles& P, const NeighborSearch& nb, const Shells& sh,
+                               const Periodic& per, double cfl) const {
+  if (!active() || sh.empty() || nb.size() != P.size()) return kInf;
+  return parallel_reduce(
+      sh.size(), kInf,
+      [&](std::size_t s) {
+        const std::size_t i = sh.at(s);
+        double k = 0.0, c = 0.0, close = kInf;
+        bool near = false;
+        visit_row(P, nb, sh, per, i, [&](const Pair& pr, double) {
+          if (!pr.near) return;
+          near = true;
+          k += pr.k;
+          c += pr.c;
+          if (pr.dt_close > 0.0) close = std::min(close, pr.dt_close);
+        });
+        if (!near) return kInf;
+        const double m = sh.mass(s);
+        double dt = 0.25 * close;
+        if (k > 0.0) dt = std::min(dt, cfl * std::sqrt(2.0 * m / k));
+        if (c > 0.0) dt = std::min(dt, cfl * 2.0 * m / c);
+        return dt;
+      },
+      [](double x, double y) { return std::min(x, y); });
+}
+
+double ShellContact::min_gap(const Particles& P, const NeighborSearch& nb, const Shells& sh,
+                             const Periodic& per) const {
+  if (sh.empty() || nb.size() != P.size()) return kInf;
+  return parallel_reduce(
+      sh.size(), kInf,
+      [&](std::size_t s) {
+        double g = kInf;
+        visit_row(P, nb, sh, per, sh.at(s), [&](const Pair& pr, double) { g = std::min(g, pr.gap); });
+        return g;
+      },
+      [](double x, double y) { return std::min(x, y); });
+}
+
+}  // namespace aortasph

@@ -1,0 +1,257 @@
+// Shell contact (sim/solid/shell_contact.hpp): two plates pressed together rest at the contact distance and
+// the contact force carries the load; a plate pressed on a wall; a sheet driven obliquely over another does
+// not pass through it between particles; the contact forces conserve momentum; 1 vs 2 threads bitwise.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "builders.hpp"
+#include "core/parallel.hpp"
+#include "solid/shell_contact.hpp"
+#include "world.hpp"
+
+using namespace aortasph;
+using namespace aortasph::test;
+
+namespace {
+
+constexpr double kDx = 1e-3, kT = 4e-4, kE = 1e6, kRho = 1000.0;
+constexpr double kP = 1e4;        // the closed valve's pressure difference, about 75 mmHg [Pa]
+constexpr double kDamp = 1500.0;  // [1/s] the plates' velocity damping, so they come to rest in 4 ms
+constexpr double kK = 1e6;        // contact modulus: K = 100 p, the gap at p is d_c K / (K + p) = 0.990 d_c
+
+Material sheet_material(double damping) {
+  Material m;
+  m.name = "sheet";
+  m.type = MaterialType::Shell;
+  m.density = kRho;
+  m.youngs_modulus = kE;
+  m.poisson_ratio = 0.3;
+  m.thickness = kT;
+  m.hourglass = 0.05;
+  m.shell_damping = damping;
+  return m;
+}
+
+Body plate(const std::string& name, int material, const Vec3& c, double a, double b, const Vec3& normal) {
+  Body p;
+  p.name = name;
+  p.material = material;
+  p.shape.kind = ShapeKind::Rectangle;
+  p.shape.center = c;
+  p.shape.size = {a, b};
+  p.shape.normal = normal;
+  p.shape.u_axis = Vec3::UnitX();
+  return p;
+}
+
+Scene base_scene() {
+  Scene s;
+  s.name = "contact";
+  s.spacing = kDx;
+  s.gravity = Vec3::Zero();
+  s.domain = {Vec3(-0.02, -0.02, -0.01), Vec3(0.02, 0.02, 0.01)};
+  s.max_dt = 1.0;
+  s.cfl = 0.5;
+  s.contact.shell_stiffness = kK;
+  return s;
+}
+
+// Contact force on the particles of body b, from a fresh evaluation on the world's lists.
+Vec3 contact_on(const World& w, int b, Vec3* total = nullptr, double* magnitude = nullptr) {
+  const Particles& P = w.particles();
+  const Scene& s = w.scene();
+  ShellContact c({s.contact.shell_stiffness, s.contact.shell_margin, s.contact.shell_damping, s.spacing},
+                 w.kernel().support);
+  std::vector<Vec3> f(P.size(), Vec3::Zero());
+  c.add_forces(P, w.neighbors(), w.shells(), Periodic(), f);
+  Vec3 sum = Vec3::Zero(), all = Vec3::Zero();
+  double mag = 0.0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.body[i] == b) sum += f[i];
+    all += f[i];
+    mag += f[i].norm();
+  }
+  if (total) *total = all;
+  if (magnitude) *magnitude = mag;
+  return sum;
+}
+
+void run(World& w, double t_end, const std::function<void()>& each) {
+  w.advance_to(t_end, [&] {
+    each();
+    return true;
+  });
+}
+
+}  // namespace
+
+TEST_CASE("shell contact: two plates pressed together rest at the contact distance and carry the load",
+          "[shell_contact]") {
+  // Two free 10 x 10 mm plates (t = 0.4 mm, dx = 1 mm), 1 mm apart, pressed together by 10 kPa each.
+  Scene s = base_scene();
+  s.materials = {sheet_material(kDamp)};
+  const double a = 10 * kDx;
+  s.bodies = {plate("lower", 0, Vec3(0, 0, -0.5e-3), a, a, Vec3::UnitZ()),
+              plate("upper", 0, Vec3(0, 0, 0.5e-3), a, a, -Vec3::UnitZ())};
+  s.bodies[0].pressure_load = TimeSeries{{}, {kP}};
+  s.bodies[1].pressure_load = TimeSeries{{}, {kP}};
+  World w(s);
+  const Particles& P = w.particles();
+  // Partners: the same lattice, one above the other.
+  std::vector<std::size_t> up(P.size(), 0);
+  for (std::size_t i = 0; i < P.size(); ++i)
+    for (std::size_t j = 0; j < P.size(); ++j)
+      if (P.body[i] == 0 && P.body[j] == 1 && (P.x0[i] - P.x0[j]).head<2>().norm() < 1e-9) up[i] = j;
+  double min_gap = 1.0;
+  const auto gaps = [&] {
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (P.body[i] == 0) min_gap = std::min(min_gap, P.x[up[i]].z() - P.x[i].z());
+  };
+  int steps = 0;
+  double dt_min = 1.0;
+  run(w, 0.004, [&] {
+    gaps();
+    ++steps;
+    dt_min = std::min(dt_min, w.last_dt());
+  });
+  const double dc = 1.5 * kT, rest = dc * kK / (kK + kP);
+  double interior = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (P.body[i] == 0 && std::abs(P.x0[i].x()) < 3e-3 && std::abs(P.x0[i].y()) < 3e-3) {
+      interior += P.x[up[i]].z() - P.x[i].z();
+      ++n;
+    }
+  interior /= n;
+  const Vec3 f = contact_on(w, 0);
+  const double load = kP * a * a;
+  INFO(steps << " steps, smallest dt " << dt_min << "; gap interior " << interior << " (barrier law " << rest
+             << "), min over run " << min_gap << ", contact force on lower " << f.transpose() << " vs load "
+             << load);
+  CHECK(min_gap > 0.5 * dc);  // never crossed, never closer than half the contact distance
+  CHECK(interior == Approx(rest).epsilon(0.02));
+  CHECK(-f.z() == Approx(load).epsilon(0.03));
+  CHECK(std::abs(f.x()) + std::abs(f.y()) < 1e-3 * load);
+}
+
+TEST_CASE("shell contact: a plate pressed on a fixed wall rests above it", "[shell_contact]") {
+  Scene s = base_scene();
+  s.materials = {sheet_material(3000.0), wall()};
+  const double a = 10 * kDx;
+  s.bodies = {box_body("floor", 1, Vec3(-0.008, -0.008, -0.003), Vec3(0.008, 0.008, 0.0)),
+              plate("plate", 0, Vec3(0, 0, 0.6e-3), a, a, -Vec3::UnitZ())};
+  s.bodies[1].pressure_load = TimeSeries{{}, {kP}};
+  World w(s);
+  const Particles& P = w.particles();
+  double zmin = 1.0;
+  run(w, 0.004, [&] {
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (P.body[i] == 1) zmin = std::min(zmin, P.x[i].z());
+  });
+  // Top wall layer at z = -dx / 2; contact distance dx / 2 + t / 2 + t / 2 from it.
+  const double dc = 0.5 * kDx + kT, rest = -0.5 * kDx + dc * kK / (kK + kP);
+  double zc = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (P.body[i] == 1 && std::abs(P.x0[i].x()) < 3e-3 && std::abs(P.x0[i].y()) < 3e-3) {
+      zc += P.x[i].z();
+      ++n;
+    }
+  zc /= n;
+  const Vec3 f = contact_on(w, 1);
+  INFO("plate height " << zc << " (barrier law " << rest << "), lowest over run " << zmin << ", force "
+                       << f.transpose());
+  CHECK(zmin > 0.0);  // above the wall's surface
+  CHECK(zc == Approx(rest).epsilon(0.02));
+  CHECK(f.z() == Approx(kP * a * a).epsilon(0.03));
+}
+
+namespace {
+
+// A 6 x 6 mm plate 1 mm over a fixed 30 x 30 mm sheet, its particles over the gaps between the sheet's
+// particles, driven at (3, 0, -2) m/s and pressed by 10 kPa: it slides 10 mm along the sheet.
+Scene sliding_scene() {
+  Scene s = base_scene();
+  s.materials = {sheet_material(0.0)};
+  s.bodies = {plate("sheet", 0, Vec3(0, 0, 0), 30 * kDx, 30 * kDx, Vec3::UnitZ()),
+              plate("slider", 0, Vec3(-7.5 * kDx, 0.5 * kDx, 1e-3), 6 * kDx, 6 * kDx, -Vec3::UnitZ())};
+  s.bodies[0].shell_fixed = {Box{Vec3(-1, -1, -1), Vec3(1, 1, 1e-4)}};
+  s.bodies[1].pressure_load = TimeSeries{{}, {kP}};
+  s.bodies[1].velocity = Vec3(3.0, 0.0, -2.0);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("shell contact: a sheet driven obliquely over another does not pass through between particles",
+          "[shell_contact]") {
+  World w(sliding_scene());
+  const Particles& P = w.particles();
+  double zmin = 1.0;
+  int steps = 0;
+  run(w, 0.0033, [&] {
+    ++steps;
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (P.body[i] == 1) zmin = std::min(zmin, P.x[i].z());
+  });
+  double xmean = 0.0, zmean = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (P.body[i] == 1) {
+      xmean += P.x[i].x() - P.x0[i].x();
+      zmean += P.x[i].z();
+      ++n;
+    }
+  xmean /= n;
+  zmean /= n;
+  const double dc = 1.5 * kT;
+  INFO(steps << " steps; slid " << xmean << " m; lowest slider particle " << zmin << " (contact distance "
+             << dc << "), mean height at the end " << zmean);
+  CHECK(xmean > 8e-3);       // it did slide (frictionless: about 3 m/s x 3.3 ms)
+  CHECK(zmin > 0.5 * dc);    // every particle stayed on its side, well clear of the sheet
+  CHECK(zmean < 1.05 * dc);  // and it is pressed onto it, not bounced off
+}
+
+TEST_CASE("shell contact: the contact forces conserve linear momentum", "[shell_contact]") {
+  // Two free plates, one tilted by 10 degrees and offset by half a spacing, colliding at 2 m/s.
+  Scene s = base_scene();
+  s.materials = {sheet_material(0.0)};
+  const Vec3 tilt = Vec3(std::sin(0.1745), 0, std::cos(0.1745));
+  s.bodies = {plate("a", 0, Vec3(0, 0, 0), 8 * kDx, 8 * kDx, tilt),
+              plate("b", 0, Vec3(0.5e-3, 0.5e-3, 2.5e-3), 8 * kDx, 8 * kDx, -Vec3::UnitZ())};
+  s.bodies[1].velocity = Vec3(0.5, 0, -2.0);
+  World w(s);
+  const auto momentum = [&] {
+    Vec3 p = Vec3::Zero();
+    for (std::size_t i = 0; i < w.particles().size(); ++i) p += w.inertial_mass(i) * w.particles().v[i];
+    return p;
+  };
+  const Vec3 p0 = momentum();
+  double worst = 0.0, fmax = 0.0;
+  run(w, 0.003, [&] {
+    Vec3 total;
+    double mag = 0.0;
+    contact_on(w, 0, &total, &mag);
+    fmax = std::max(fmax, mag);
+    worst = std::max(worst, total.norm() / std::max(mag, 1e-300));
+  });
+  const Vec3 p1 = momentum();
+  INFO("momentum " << p0.transpose() << " -> " << p1.transpose() << "; largest |sum f| / sum |f| " << worst
+                   << ", largest sum |f| " << fmax);
+  CHECK(fmax > 0.1);  // they did collide
+  CHECK(worst < 1e-12);
+  CHECK((p1 - p0).norm() < 1e-12 * p0.norm());
+}
+
+TEST_CASE("shell contact: 1 vs 2 threads bitwise identical", "[shell_contact]") {
+  const int threads = max_threads();
+  uint64_t h[2];
+  for (int k = 0; k < 2; ++k) {
+    set_threads(k + 1);
+    World w(sliding_scene());
+    run(w, 0.0005, [] {});
+    h[k] = state_hash(w);
+  }
+  set_threads(threads);
+  CHECK(h[0] == h[1]);
+}
