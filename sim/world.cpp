@@ -263,13 +263,15 @@ double World::stable_dt() const {
   if (scene_.fixed_dt > 0.0) return scene_.fixed_dt;
   const double h = kernel_.h;
   double dt = scene_.max_dt;
-  // Acoustic CFL (Monaghan 1992): information crosses h in no less than h / (c0 + |v|max).
-  if (max_c0_ > 0.0) dt = std::min(dt, scene_.cfl * h / (max_c0_ + max_speed_));
+  // Acoustic CFL (Monaghan 1992): information crosses h in no less than h / (c0 + |v|max). |v|max includes
+  // the shells' own sub-step speeds, so that a sheet also moves less than cfl h (a third of a spacing) per
+  // fluid step: the coupling (side labels, the guard, the imaginary particles of sim/boundary/shell_coupling)
+  // is rebuilt once per step and needs the sheet to move a fraction of a spacing in between.
+  if (max_c0_ > 0.0) dt = std::min(dt, scene_.cfl * h / (max_c0_ + std::max(max_speed_, sub_.max_speed)));
   // Elastic solids: the same condition with the P-wave speed sqrt((lambda + 2 mu) / rho), the fastest signal
   // of the solid.
   if (!solids_.empty()) dt = std::min(dt, scene_.cfl * h / (solids_.max_wave_speed() + max_speed_));
-  // Shells: the plate wave and the shear-rotary limit (Shells::stable_dt).
-  if (!shells_.empty()) dt = std::min(dt, shells_.stable_dt(scene_.cfl, max_speed_));
+  // Shells do not bound the step: they take their own sub-steps within it (step_shells).
   // Shell contact: the contact spring and damper of the particles near contact (ShellContact::stable_dt),
   // from the lists (stale right after particles were created or removed: then the bound waits a step).
   if (shell_contact_.active() && lists_valid_)
@@ -419,7 +421,8 @@ void World::integrate(double dt) {
   const double kick = kick_length(dt);
   const Periodic& per = ctx_.periodic;
   parallel_for(P_.size(), [&](std::size_t i) {
-    if (P_.kind[i] != Kind::Fluid && P_.kind[i] != Kind::Elastic && P_.kind[i] != Kind::Shell) return;
+    // (Shells advanced themselves in step_shells, in sub-steps.)
+    if (P_.kind[i] != Kind::Fluid && P_.kind[i] != Kind::Elastic) return;
     P_.v[i] += kick * P_.a[i];
     P_.x[i] += dt * P_.v[i];
     if (!shift_.empty()) P_.x[i] += shift_[i];
@@ -432,6 +435,8 @@ void World::integrate(double dt) {
       P_.size(), Extremes{},
       [&](std::size_t i) {
         if (P_.kind[i] == Kind::Wall) return Extremes{};
+        // Shells: their acceleration bounds their sub-steps (shell_stable_dt), not the step.
+        if (P_.kind[i] == Kind::Shell) return Extremes{P_.v[i].squaredNorm(), 0.0};
         return Extremes{P_.v[i].squaredNorm(), P_.a[i].squaredNorm()};
       },
       [](const Extremes& a, const Extremes& b) {
@@ -508,32 +513,97 @@ void World::add_shell_seeds(const Body& body, const std::string& where, const Sh
   apply(body.shell_fixed, "fixed", 1);
 }
 
-// Shells: resultants, internal forces and director moments (Shells::update), plus what body_forces() found,
-// gravity, the body's pressure load p(t) A n along the current normal and the material's damping; then the
-// directors turn (their leapfrog, like integrate() for positions). Supported particles hold their position
-// (and, fixed, their director).
+// Shells, sub-cycled within the step (issue 16; the multi-time-step coupling of Zhang, Rezavand & Hu 2021,
+// J. Comput. Phys. 429, 110028, as SPHinXsys runs it): the step dt is the fluid's (and other bodies'), and
+// the shells take n = ceil(dt / dt_shell) equal sub-steps h = dt / n inside it, with what body_forces() found
+// (the fluid's reaction, contact) held over them. Each sub-step is the leapfrog of integrate() on the shells'
+// own velocities (sub_.v, half a sub-step behind the positions): the first kick spans the last sub-step of
+// the previous step and this one, (h_prev + h) / 2, the others h. What the fluid sees of a shell particle is
+// its end position, its mean velocity over the step (the mean of the sub-steps' velocities, (x(t + dt) -
+// x(t)) / dt: the half-step velocity of the fluid's own leapfrog) in P.v, and its mean acceleration in P.a.
+// With n = 1 this is the plain leapfrog of integrate(), bit for bit.
 void World::step_shells(double dt) {
+  const std::size_t ns = shells_.size();
+  if (sub_.v.size() != ns) {  // the first step (or a checkpoint without this state): from P.v
+    sub_.v.resize(ns);
+    sub_.max_speed = 0.0;
+    for (std::size_t s = 0; s < ns; ++s) {
+      sub_.v[s] = P_.v[shells_.at(s)];
+      sub_.max_speed = std::max(sub_.max_speed, sub_.v[s].norm());
+    }
+    sub_.max_accel = gravity_.norm();
+    sub_.last_h = last_dt_;
+  }
+  const int n = std::max(1, static_cast<int>(std::ceil(dt / shell_stable_dt() * (1.0 - 1e-12))));
+  const double h = dt / n;
+  std::vector<Vec3> held(ns), vsum(ns, Vec3::Zero()), asum(ns, Vec3::Zero());
+  std::vector<double> v2(ns, 0.0), a2(ns, 0.0);
+  parallel_for(ns, [&](std::size_t s) { held[s] = force_[shells_.at(s)]; });
+  for (int k = 0; k < n; ++k) {
+    const double kick = k == 0 && sub_.last_h > 0.0 ? 0.5 * (sub_.last_h + h) : h;
+    shell_substep(h, kick, time_ + k * h, held);
+    parallel_for(ns, [&](std::size_t s) {
+      const uint32_t i = shells_.at(s);
+      vsum[s] += sub_.v[s];
+      asum[s] += P_.a[i];
+      v2[s] = std::max(v2[s], sub_.v[s].squaredNorm());
+      a2[s] = std::max(a2[s], P_.a[i].squaredNorm());
+    });
+  }
+  parallel_for(ns, [&](std::size_t s) {
+    const uint32_t i = shells_.at(s);
+    P_.v[i] = vsum[s] / static_cast<double>(n);
+    P_.a[i] = asum[s] / static_cast<double>(n);
+  });
+  const auto max = [](double a, double b) { return std::max(a, b); };
+  sub_.max_speed = std::sqrt(parallel_reduce(
+      ns, 0.0, [&](std::size_t s) { return v2[s]; }, max));
+  sub_.max_accel = std::max(std::sqrt(parallel_reduce(
+                                ns, 0.0, [&](std::size_t s) { return a2[s]; }, max)),
+                            gravity_.norm());
+  sub_.last_h = h;
+  sub_.last_n = n;
+  sub_.substeps += n;
+}
+
+// One shell sub-step of length h at time t: resultants, internal forces and director moments
+// (Shells::update), plus the held forces, gravity, the body's pressure load p(t) A n along the current normal
+// and the material's damping; then velocity, position and director (their leapfrog). Supported particles hold
+// their position (and, fixed, their director).
+void World::shell_substep(double h, double kick, double t, const std::vector<Vec3>& held) {
   shells_.update(P_);
-  shells_.add_forces(force_);
   std::vector<double> pressure(bodies_.size(), 0.0);
   for (std::size_t b = 0; b < bodies_.size(); ++b)
-    if (scene_.bodies[b].pressure_load) pressure[b] = scene_.bodies[b].pressure_load->at(time_);
+    if (scene_.bodies[b].pressure_load) pressure[b] = scene_.bodies[b].pressure_load->at(t);
+  const Periodic& per = ctx_.periodic;
   parallel_for(shells_.size(), [&](std::size_t s) {
     const uint32_t i = shells_.at(s);
+    Vec3& v = sub_.v[s];
     if (shells_.support(s) == 1 || shells_.support(s) == 2) {
       P_.a[i] = Vec3::Zero();
-      P_.v[i] = Vec3::Zero();
+      v = Vec3::Zero();
       return;
     }
-    const Vec3 f = force_[i] + pressure[P_.body[i]] * shells_.area(s) * shells_.normal(s);
-    P_.a[i] = f / shells_.mass(s) + gravity_ - shells_.damping(s) * P_.v[i];
+    const Vec3 f =
+        held[s] + shells_.internal_force(s) + pressure[P_.body[i]] * shells_.area(s) * shells_.normal(s);
+    P_.a[i] = f / shells_.mass(s) + gravity_ - shells_.damping(s) * v;
     if (shells_.support(s) == 3) {  // a diaphragm (validations): held in the plane across free_axis
       const Vec3& ax = shells_.free_axis(s);
       P_.a[i] = P_.a[i].dot(ax) * ax;
-      P_.v[i] = P_.v[i].dot(ax) * ax;
+      v = v.dot(ax) * ax;
     }
+    v += kick * P_.a[i];
+    P_.x[i] += h * v;
+    if (per.any) per.wrap(P_.x[i]);
   });
-  shells_.advance_directors(dt, kick_length(dt));
+  shells_.advance_directors(h, kick);
+}
+
+double World::shell_stable_dt() const {
+  double dt = shells_.stable_dt(scene_.cfl, sub_.max_speed);
+  // Force limit (Monaghan 1992) on the shells' own accelerations.
+  if (sub_.max_accel > 0.0) dt = std::min(dt, 0.25 * std::sqrt(kernel_.h / sub_.max_accel));
+  return dt;
 }
 
 // Rigid bodies, eqs. (19)-(22): the per-particle forces of body_forces() summed per body in array order (the
@@ -710,6 +780,14 @@ void World::save_state(StateWriter& out) const {
   sh.array(shells_.directors());
   sh.array(shells_.omegas());
 
+  if (!shells_.empty()) {  // shell sub-cycling (step_shells): a section of its own, older checkpoints lack it
+    SectionWriter& ss = out.section("shell_subcycle", 1);
+    for (double v : {sub_.last_h, sub_.max_speed, sub_.max_accel}) ss.value(v);
+    ss.value(sub_.substeps);
+    ss.value(sub_.last_n);
+    ss.array(sub_.v);
+  }
+
   if (coupling_.active()) {  // a section of its own: older checkpoints and shell-free scenes lack it
     SectionWriter& sc = out.section("shell_coupling", 1);
     sc.value(coupling_.crossings());
@@ -791,6 +869,17 @@ void World::load_state(const StateReader& in) {
     sh.array(shells_.directors(), "shell directors", shells_.size());
     sh.array(shells_.omegas(), "shell angular velocities", shells_.size());
     sh.done();
+  }
+  sub_ = ShellSubcycle{};  // without the section: rebuilt from P.v at the next step
+  if (in.has("shell_subcycle")) {
+    SectionReader ss = in.section("shell_subcycle");
+    for (double* v : {&sub_.last_h, &sub_.max_speed, &sub_.max_accel}) *v = ss.value<double>();
+    sub_.substeps = ss.value<long>();
+    sub_.last_n = ss.value<int>();
+    ss.array(sub_.v, "shell sub-cycle velocities");
+    ss.done();
+    if (!sub_.v.empty() && sub_.v.size() != shells_.size())
+      ss.mismatch("shell sub-cycle velocities", sub_.v.size(), shells_.size());
   }
 
   SectionReader nb = in.section("neighbors");

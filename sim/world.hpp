@@ -91,6 +91,7 @@ class World {
       if (sh >= 0 && shells_.support(static_cast<std::size_t>(sh)) != 0) continue;
       P_.v[i] = v_of_x0(P_.x0[i]);
       max_speed_ = std::max(max_speed_, P_.v[i].norm());
+      if (sh >= 0 && !sub_.v.empty()) sub_.v[static_cast<std::size_t>(sh)] = P_.v[i];
     }
   }
 
@@ -141,6 +142,14 @@ class World {
   // Fluid on both sides of the shells (sim/boundary/shell_coupling.hpp): fluid particles put back on their
   // side of a sheet since t = 0 (0 when the coupling holds), and the pairs masked in the last step.
   long shell_crossings() const { return coupling_.crossings(); }
+  // Shell sub-cycling (World::step_shells): shell sub-steps taken since t = 0, the number in the last step,
+  // and the shells' own leapfrog velocities by shell slot (P.v of a shell particle is its mean over the
+  // step, what the fluid sees).
+  long shell_substeps() const { return sub_.substeps; }
+  int last_shell_substeps() const { return sub_.last_n; }
+  const std::vector<Vec3>& shell_velocities() const { return sub_.v; }
+  // The shells' own stable step (plate wave, shear-rotary, force limit): the sub-step bound.
+  double shell_stable_dt() const;
   std::size_t shell_masked_pairs() const { return coupling_.masked_pairs(); }
   Shells& shells_for_test() { return shells_; }
   const CubicSpline& kernel() const { return kernel_; }
@@ -184,6 +193,7 @@ class World {
   void step_rigid(double dt);
   void step_solids();
   void step_shells(double dt);
+  void shell_substep(double h, double kick, double t, const std::vector<Vec3>& held);
   void add_shell_seeds(const Body& body, const std::string& where, const ShapeSample& sample,
                        std::size_t first, std::vector<ShellSeed>& seeds) const;
   void permute(const std::vector<uint32_t>& order);
@@ -203,7 +213,16 @@ class World {
   Shells shells_;
   ShellSheets sheets_;      // the shells' triangulated mid-surfaces (render, VTK)
   ShellCoupling coupling_;  // active when a scene has shells and a fluid
-  OpenBoundaries open_;     // inflows and outflows; their counters are plain values (OpenBoundaryState)
+  // Shell sub-cycling state (step_shells): leapfrog velocities by shell slot (empty until the first step,
+  // then filled from P.v), the last sub-step's length, the largest speed and acceleration of the last step's
+  // sub-steps, and counters.
+  struct ShellSubcycle {
+    std::vector<Vec3> v;
+    double last_h = 0.0, max_speed = 0.0, max_accel = 0.0;
+    long substeps = 0;
+    int last_n = 0;
+  } sub_;
+  OpenBoundaries open_;  // inflows and outflows; their counters are plain values (OpenBoundaryState)
   ContactParams contact_;
   ShellContact shell_contact_;  // sheets against sheets and walls (active when contact.shell_stiffness > 0)
   double min_contact_mass_ = std::numeric_limits<double>::max();

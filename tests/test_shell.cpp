@@ -288,7 +288,14 @@ Scene strip_scene(double L, double b, double t, double dx, double E, double rho)
 double total_energy(const World& w) {
   const Particles& P = w.particles();
   double kin = 0.0;
-  for (std::size_t i = 0; i < P.size(); ++i) kin += 0.5 * w.inertial_mass(i) * P.v[i].squaredNorm();
+  // Shell particles: their own leapfrog velocity (P.v is its mean over the sub-cycled step, what the fluid
+  // sees).
+  const std::vector<Vec3>& vs = w.shell_velocities();
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    const long s = w.shells().slot(i);
+    const Vec3& v = s >= 0 && !vs.empty() ? vs[static_cast<std::size_t>(s)] : P.v[i];
+    kin += 0.5 * w.inertial_mass(i) * v.squaredNorm();
+  }
   return kin + w.shells().rotational_energy() + w.shells().energy();
 }
 

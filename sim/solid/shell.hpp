@@ -90,6 +90,8 @@ class Shells {
   // Current mid-surface normal (G column 0 x column 1, normalised; oriented like N).
   Vec3 normal(std::size_t s) const;
   const Vec3& torque(std::size_t s) const { return torque_[s]; }
+  // Internal force of the last update() on slot s [N] (what add_forces() adds).
+  const Vec3& internal_force(std::size_t s) const { return force_[s]; }
   double von_mises(std::size_t s) const { return vm_[s]; }
   // Resultants per unit reference length in the particle's reference tangent frame (T1, T2, N):
   // membrane force N [N/m], moment M [N m / m], transverse shear force Q [N/m] (PK2 through the thickness).
