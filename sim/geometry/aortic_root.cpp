@@ -44,6 +44,8 @@ constexpr double kWallMargin = 0.4;      // ... and this far inside the lumen su
 constexpr double kClampDepth = 1.0;      // clamped: within this distance of the lumen surface (the first row)
 constexpr double kLayerMin = 0.6;        // leaflet particles of one leaflet at least this far apart
 constexpr double kBloodGap = 0.9;        // blood lattice points at least this far from leaflet particles
+constexpr double kShellBloodGap = 0.5;   // ... from a shell leaflet's sheet (along its normal)
+constexpr double kShellPatch = 0.75;     // ... over a shell particle's patch (tangential offset, in dx)
 constexpr int kMeridianSamples = 100;    // arc-length table along a leaflet meridian
 constexpr int kAttachmentSamples = 512;  // mirror leaflets: attachment heights tabulated across a sector
 
@@ -346,7 +348,8 @@ std::vector<Vec3> AorticRoot::wall_points(double dx, SurfaceMesh* mesh) const {
 // ---------------------------------------------------------------------------------------------------------
 // Leaflets
 
-std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8_t>* clamped) const {
+void AorticRoot::leaflet_mid_surface(int k, double dx, std::vector<Vec3>& mids, std::vector<Vec3>& normals,
+                                     std::vector<double>* areas) const {
   // The sheet is built on the surface inset by half a spacing from both coaptation planes, so its free edges
   // lie dx/2 from them and the neighbouring leaflet's particles are dx away across each plane.
   const double inset = 0.5 * dx;
@@ -407,8 +410,11 @@ std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8
   };
 
   // Mid-surface points with their normals, row by row, equally spaced by arc length along each row.
-  std::vector<Vec3> mids, normals;
+  mids.clear();
+  normals.clear();
+  if (areas) areas->clear();
   const int arc_samples = 128;
+  double prev_total = 0.0;  // the previous row's length (for the apex's area)
   for (int i = 0; i < rows; ++i) {
     std::vector<double> ss(arc_samples + 1), cl(arc_samples + 1);
     Vec3 prev = Vec3::Zero();
@@ -436,12 +442,30 @@ std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8
       const double rn = std::max(rho, 1e-3), e = 1e-6;
       const Vec3 d_rho = surface_at(rn + e, s) - surface_at(rn, s);
       const Vec3 d_s = surface_at(rn, s + e) - surface_at(rn, s - e);
-      Vec3 nrm = d_rho.cross(d_s).normalized();
-      if (nrm.y() < 0) nrm = -nrm;
       mids.push_back(surface_at(rho, s));
-      normals.push_back(nrm);
+      normals.push_back(d_rho.cross(d_s).normalized());
+      if (areas) {
+        // The surface element this point stands for (shell leaflets): across the rows, half way to each
+        // neighbouring row (the first row reaches back to the attachment line, the apex row covers half a
+        // row spacing); along the row, half way to each neighbour. The apex, where the rows shrink to a
+        // point, gets the wedge of the last half row spacing, 1/8 of the previous row's length times the
+        // spacing.
+        const double h = (meridian_at(s).back() - kFirstRow * dx) / (rows - 1);
+        const double across = i == 0 ? kFirstRow * dx + 0.5 * h : i == rows - 1 ? 0.5 * h : h;
+        double along = n == 1 ? total : total / (n - 1);
+        if (n > 1 && (m == 0 || m == n - 1)) along *= 0.5;
+        areas->push_back(n == 1 && i == rows - 1 ? 0.125 * h * prev_total : across * along);
+      }
     }
+    prev_total = total;
   }
+}
+
+std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8_t>* clamped) const {
+  std::vector<Vec3> mids, normals;
+  leaflet_mid_surface(k, dx, mids, normals, nullptr);
+  for (Vec3& nrm : normals)
+    if (nrm.y() < 0) nrm = -nrm;
 
   // Layers through the thickness, centred on the surface, the mid-surface first, then outwards in pairs
   // (ventricular side first). Where the sheet is folded tighter than its thickness, the concave side's
@@ -490,6 +514,34 @@ std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8
   return out;
 }
 
+ShapeSample AorticRoot::leaflet_shell(int k, double dx) const {
+  ShapeSample out;
+  std::vector<Vec3> mids, normals;
+  std::vector<double> areas;
+  leaflet_mid_surface(k, dx, mids, normals, &areas);
+  // One orientation over the whole sheet: d_rho x d_s keeps its side on the regular (rho, s) patch; its sign
+  // is chosen so that the normal mid-belly points up the root (from the ventricle to the aorta).
+  const double e = 1e-6, inset = 0.5 * dx;
+  const Vec3 belly_n =
+      (leaflet_surface(k, 0.5 + e, 0.5, inset) - leaflet_surface(k, 0.5, 0.5, inset))
+          .cross(leaflet_surface(k, 0.5, 0.5 + e, inset) - leaflet_surface(k, 0.5, 0.5 - e, inset));
+  const double sign = belly_n.y() < 0 ? -1.0 : 1.0;
+  for (std::size_t m = 0; m < mids.size(); ++m) {
+    const Vec3& q = mids[m];
+    const double r = std::hypot(q.x(), q.z()), th = std::atan2(-q.z(), q.x());
+    double s = 0.0;
+    if (sector_of(th, s) != k) continue;
+    if (sector_distance(r, s * dphi_[k], dphi_[k]) < kSectorMargin * dx) continue;
+    const double depth = (lumen_radius(q.y(), th) - r) / normal_scale(q.y(), th);
+    if (depth < kWallMargin * dx || q.y() < -p_.lvot_length + 0.5 * dx) continue;
+    out.points.push_back(p_.base + q);
+    out.normals.push_back(sign * normals[m]);
+    out.areas.push_back(areas[m]);
+    out.clamped.push_back(depth < kClampDepth * dx ? 1 : 0);
+  }
+  return out;
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Blood
 
@@ -503,20 +555,41 @@ std::vector<Vec3> AorticRoot::blood_points(double dx) const {
            (static_cast<int64_t>(c.z()) + (1 << 20));
   };
   double leaf_lo = 1e300, leaf_hi = -1e300;  // heights (relative to base) the leaflets span, +- dx
-  for (int k = 0; k < 3; ++k)
-    for (const Vec3& q : leaflet_points(k, dx, nullptr)) {
+  // Shell leaflets: the normals too (indexed like the grid's points).
+  std::unordered_map<int64_t, std::vector<Vec3>> grid_n;
+  for (int k = 0; k < 3; ++k) {
+    ShapeSample shell;
+    if (p_.shell_leaflets) shell = leaflet_shell(k, dx);
+    const std::vector<Vec3> pts = p_.shell_leaflets ? shell.points : leaflet_points(k, dx, nullptr);
+    for (std::size_t m = 0; m < pts.size(); ++m) {
+      const Vec3& q = pts[m];
       grid[cell(q)].push_back(q);
+      if (p_.shell_leaflets) grid_n[cell(q)].push_back(shell.normals[m]);
       leaf_lo = std::min(leaf_lo, q.y() - p_.base.y() - dx);
       leaf_hi = std::max(leaf_hi, q.y() - p_.base.y() + dx);
     }
+  }
   auto near_leaflet = [&](const Vec3& q) {
     for (int a = -1; a <= 1; ++a)
       for (int b = -1; b <= 1; ++b)
         for (int c = -1; c <= 1; ++c) {
-          const auto it = grid.find(cell(q + dx * Vec3(a, b, c)));
+          const int64_t key = cell(q + dx * Vec3(a, b, c));
+          const auto it = grid.find(key);
           if (it == grid.end()) continue;
-          for (const Vec3& o : it->second)
-            if ((o - q).squaredNorm() < kBloodGap * kBloodGap * dx * dx) return true;
+          for (std::size_t m = 0; m < it->second.size(); ++m) {
+            const Vec3 d = q - it->second[m];
+            if (!p_.shell_leaflets) {
+              if (d.squaredNorm() < kBloodGap * kBloodGap * dx * dx) return true;
+              continue;
+            }
+            // A shell is a sheet, not a row of balls: a point over a shell particle's patch (tangential
+            // offset < kShellPatch dx) must be kShellBloodGap dx off the sheet along its normal, and every
+            // point that far from the particle itself (round the free edges).
+            const double dn = std::abs(d.dot(grid_n[key][m]));
+            const double dt = (d - d.dot(grid_n[key][m]) * grid_n[key][m]).norm();
+            if (d.norm() < kShellBloodGap * dx || (dn < kShellBloodGap * dx && dt < kShellPatch * dx))
+              return true;
+          }
         }
     return false;
   };
@@ -638,7 +711,10 @@ ShapeSample sample_aortic_root(const AorticRootParams& p, AorticPart part, int l
       out.points = root.blood_points(dx);
       break;
     case AorticPart::Leaflet:
-      out.points = root.leaflet_points(std::clamp(leaflet, 0, 2), dx, &out.clamped);
+      if (p.shell_leaflets)
+        out = root.leaflet_shell(std::clamp(leaflet, 0, 2), dx);
+      else
+        out.points = root.leaflet_points(std::clamp(leaflet, 0, 2), dx, &out.clamped);
       break;
   }
   return out;
