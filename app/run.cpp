@@ -663,6 +663,12 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
   // Aortic leaflets are layers x dx thick, far thicker than a real leaflet: the modulus that bends alike.
   for (const Body& b : scene.bodies)
     if (b.shape.kind == ShapeKind::AorticRoot && b.shape.aortic_part == AorticPart::Leaflet) {
+      if (b.shape.aortic.shell_leaflets) {  // one layer at the material's thickness (issue 16)
+        const Material& m = scene.materials[b.material];
+        std::printf("  aortic leaflets: shells %g mm thick (one layer), E = %.3g MPa\n", m.thickness * 1e3,
+                    m.youngs_modulus / 1e6);
+        break;
+      }
       const double t = b.shape.aortic.leaflet_layers * scene.spacing;
       const double E = scene.materials[b.material].youngs_modulus;
       // E_real = E (t / t_real)^3: the inverse of bending_equivalent_modulus, t_real = 0.4 mm.

@@ -263,6 +263,7 @@ class Loader {
         if (s.bodies[b].name == s.bodies[c].name)
           fail(index("bodies", b) + ".name", "duplicate body name '" + s.bodies[b].name + "'");
     if (s.bodies.size() > 60000) fail("bodies", "too many bodies");
+    shell_leaflets(s);
 
     if (top.has("open_boundaries")) {
       json& obs = top.raw("open_boundaries");
@@ -460,6 +461,28 @@ class Loader {
     }
   }
 
+  // Shell aortic leaflets (issue 16): all three leaflets of a root are shells or none is; the root's other
+  // parts (wall, blood) learn it, so the blood keeps its gap from the one-layer sheets.
+  void shell_leaflets(Scene& s) {
+    int shells = 0, leaflets = 0;
+    std::size_t volumetric = 0;
+    for (std::size_t b = 0; b < s.bodies.size(); ++b) {
+      const Shape& sh = s.bodies[b].shape;
+      if (sh.kind != ShapeKind::AorticRoot || sh.aortic_part != AorticPart::Leaflet) continue;
+      ++leaflets;
+      if (sh.aortic.shell_leaflets)
+        ++shells;
+      else
+        volumetric = b;
+    }
+    if (shells == 0) return;
+    if (shells != leaflets)
+      fail(index("bodies", volumetric) + ".material",
+           "the aortic leaflets are shells or none is: this leaflet's material is not a shell, another's is");
+    for (Body& b : s.bodies)
+      if (b.shape.kind == ShapeKind::AorticRoot) b.shape.aortic.shell_leaflets = true;
+  }
+
   // A shell material (sim/solid/shell.hpp): plane-stress SVK or incompressible neo-Hookean, thickness a
   // parameter of at most kMaxShellThickness spacings (a thicker sheet is resolved by a volumetric solid).
   static constexpr double kMaxShellThickness = 4.0;
@@ -516,8 +539,12 @@ class Loader {
         fail(o.path("material"), "the aortic root's wall needs a wall material");
       if (part == AorticPart::Blood && t != MaterialType::Fluid)
         fail(o.path("material"), "the aortic root's blood needs a fluid material");
-      if (part == AorticPart::Leaflet && t != MaterialType::Elastic && t != MaterialType::Wall)
-        fail(o.path("material"), "an aortic leaflet needs an elastic (or, held still, a wall) material");
+      if (part == AorticPart::Leaflet && t != MaterialType::Elastic && t != MaterialType::Wall &&
+          t != MaterialType::Shell)
+        fail(o.path("material"),
+             "an aortic leaflet needs an elastic, a shell (or, held still, a wall) material");
+      // A shell leaflet: one layer on the mid-surface (sim/geometry/aortic_root.hpp, leaflet_shell).
+      if (part == AorticPart::Leaflet && t == MaterialType::Shell) b.shape.aortic.shell_leaflets = true;
     }
     b.translate = o.vec3("translate", Vec3::Zero());
     if (o.has("rotate")) {
@@ -540,9 +567,7 @@ class Loader {
                : mode == "hidden" ? RenderMode::Hidden
                                   : RenderMode::Particles;
     const bool shell = s.materials[b.material].type == MaterialType::Shell;
-    if (shell != is_shell_shape(b.shape.kind)) {
-      if (shell && b.shape.kind == ShapeKind::AorticRoot)
-        fail(o.path("material"), "shell aortic leaflets are not supported yet (issue 16, later work)");
+    if (shell != (is_shell_shape(b.shape.kind) || b.shape.aortic.shell_leaflets)) {
       fail(o.path("material"),
            shell ? "a shell material needs a shell shape (rectangle, disc or cylindrical_panel)"
                  : "a shell shape (rectangle, disc, cylindrical_panel) needs a shell material");

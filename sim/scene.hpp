@@ -99,6 +99,10 @@ struct AorticRootParams {
   // Mirror leaflets: the open leaflet's lines leave the attachment leaning this much outward (into the sinus)
   // from the cone's [degrees]; 0: the cone itself.
   double mirror_tilt = 0.0;
+  // Not a scene key: true when the leaflets are shells (a leaflet body with a shell material, issue 16), set
+  // by the scene loader on every part of the root, so the leaflets sample one layer on their mid-surface and
+  // the blood keeps its gap from that layer (sim/geometry/aortic_root.hpp).
+  bool shell_leaflets = false;
 
   double stj() const { return stj_height > 0.0 ? stj_height : commissure_height; }
   double aorta() const { return aorta_radius > 0.0 ? aorta_radius : commissure_radius; }

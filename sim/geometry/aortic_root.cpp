@@ -38,14 +38,18 @@ double wrap(double a) {
 }
 
 // Leaflet sheet: rows this far (in dx) from the attachment line, and the margins that keep bodies apart.
-constexpr double kFirstRow = 0.5;        // first row's arc length from the attachment line
-constexpr double kSectorMargin = 0.45;   // leaflet particles at least this far from a neighbour's sector
-constexpr double kWallMargin = 0.4;      // ... and this far inside the lumen surface
-constexpr double kClampDepth = 1.0;      // clamped: within this distance of the lumen surface (the first row)
-constexpr double kLayerMin = 0.6;        // leaflet particles of one leaflet at least this far apart
-constexpr double kBloodGap = 0.9;        // blood lattice points at least this far from leaflet particles
-constexpr int kMeridianSamples = 100;    // arc-length table along a leaflet meridian
-constexpr int kAttachmentSamples = 512;  // mirror leaflets: attachment heights tabulated across a sector
+constexpr double kFirstRow = 0.5;       // first row's arc length from the attachment line
+constexpr double kSectorMargin = 0.45;  // leaflet particles at least this far from a neighbour's sector
+constexpr double kWallMargin = 0.4;     // ... and this far inside the lumen surface
+constexpr double kClampDepth = 1.0;     // clamped: within this distance of the lumen surface (the first row)
+constexpr double kLayerMin = 0.6;       // leaflet particles of one leaflet at least this far apart
+constexpr double kBloodGap = 0.9;       // blood lattice points at least this far from leaflet particles
+constexpr double kShellWallMargin = 0.1;  // shell leaflets: the sheet this far inside the lumen surface
+constexpr double kShellClampDepth = 0.6;  // ... clamped: its first row, and within this of the lumen surface
+constexpr double kShellBloodGap = 0.5;    // ... from a shell leaflet's sheet (along its normal)
+constexpr double kShellPatch = 0.75;      // ... over a shell particle's patch (tangential offset, in dx)
+constexpr int kMeridianSamples = 100;     // arc-length table along a leaflet meridian
+constexpr int kAttachmentSamples = 512;   // mirror leaflets: attachment heights tabulated across a sector
 
 // Projected distance of a point at polar angle offset a inside a sector of width w, radius r, to the
 // sector's two bounding half-planes (rays in projection).
@@ -346,7 +350,8 @@ std::vector<Vec3> AorticRoot::wall_points(double dx, SurfaceMesh* mesh) const {
 // ---------------------------------------------------------------------------------------------------------
 // Leaflets
 
-std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8_t>* clamped) const {
+void AorticRoot::leaflet_mid_surface(int k, double dx, std::vector<Vec3>& mids, std::vector<Vec3>& normals,
+                                     std::vector<double>* areas, std::vector<int>* row_of) const {
   // The sheet is built on the surface inset by half a spacing from both coaptation planes, so its free edges
   // lie dx/2 from them and the neighbouring leaflet's particles are dx away across each plane.
   const double inset = 0.5 * dx;
@@ -407,7 +412,10 @@ std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8
   };
 
   // Mid-surface points with their normals, row by row, equally spaced by arc length along each row.
-  std::vector<Vec3> mids, normals;
+  mids.clear();
+  normals.clear();
+  if (areas) areas->clear();
+  if (row_of) row_of->clear();
   const int arc_samples = 128;
   for (int i = 0; i < rows; ++i) {
     std::vector<double> ss(arc_samples + 1), cl(arc_samples + 1);
@@ -420,6 +428,7 @@ std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8
     }
     const double total = cl.back();
     const int n = std::max(1, static_cast<int>(std::lround(total / dx)) + 1);
+    std::vector<double> row_s(n);
     for (int m = 0; m < n; ++m) {
       const double target = n == 1 ? 0.5 * total : total * m / (n - 1);
       const auto it = std::lower_bound(cl.begin(), cl.end(), target);
@@ -431,17 +440,52 @@ std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8
         const double t = (target - cl[a - 1]) / std::max(cl[a] - cl[a - 1], 1e-300);
         s = ss[a - 1] + t * (ss[a] - ss[a - 1]);
       }
+      row_s[m] = s;
+    }
+    for (int m = 0; m < n; ++m) {
+      const double s = row_s[m];
       const double rho = row_rho(i, s);
       // Normal from the surface's tangents (at the apex, from just beside it).
       const double rn = std::max(rho, 1e-3), e = 1e-6;
       const Vec3 d_rho = surface_at(rn + e, s) - surface_at(rn, s);
       const Vec3 d_s = surface_at(rn, s + e) - surface_at(rn, s - e);
-      Vec3 nrm = d_rho.cross(d_s).normalized();
-      if (nrm.y() < 0) nrm = -nrm;
       mids.push_back(surface_at(rho, s));
-      normals.push_back(nrm);
+      normals.push_back(d_rho.cross(d_s).normalized());
+      if (row_of) row_of->push_back(i);
+      if (!areas) continue;
+      // The surface element this point stands for (shell leaflets): the cell between the meridians half way
+      // to the row's neighbouring points (s = 0 and 1 at the row's ends) and the lines half way to the
+      // neighbouring rows (by arc length along each meridian; the first row's cell reaches back to the
+      // attachment line, the apex row's to the apex). The cells tile the mid-surface; each is summed as a
+      // 2 x 2 grid of flat quads on the surface.
+      const double s_lo = m == 0 ? 0.0 : 0.5 * (row_s[m - 1] + s),
+                   s_hi = m == n - 1 ? 1.0 : 0.5 * (s + row_s[m + 1]);
+      auto cell_point = [&](double sc, double v) {
+        const std::vector<double>& mc = meridian_at(sc);
+        const double L = mc.back(), h = (L - kFirstRow * dx) / (rows - 1);
+        const double c = kFirstRow * dx + i * h;
+        const double lo = i == 0 ? 0.0 : c - 0.5 * h, hi = i == rows - 1 ? L : c + 0.5 * h;
+        return surface_at(rho_at(mc, L - (lo + v * (hi - lo))), sc);
+      };
+      Vec3 g[3][3];
+      const double su[3] = {s_lo, s, s_hi};
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) g[a][b] = cell_point(su[a], 0.5 * b);
+      double area = 0.0;
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b)
+          area += 0.5 * ((g[a + 1][b] - g[a][b]).cross(g[a + 1][b + 1] - g[a][b]).norm() +
+                         (g[a + 1][b + 1] - g[a][b]).cross(g[a][b + 1] - g[a][b]).norm());
+      areas->push_back(area);
     }
   }
+}
+
+std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8_t>* clamped) const {
+  std::vector<Vec3> mids, normals;
+  leaflet_mid_surface(k, dx, mids, normals, nullptr, nullptr);
+  for (Vec3& nrm : normals)
+    if (nrm.y() < 0) nrm = -nrm;
 
   // Layers through the thickness, centred on the surface, the mid-surface first, then outwards in pairs
   // (ventricular side first). Where the sheet is folded tighter than its thickness, the concave side's
@@ -490,6 +534,49 @@ std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8
   return out;
 }
 
+ShapeSample AorticRoot::leaflet_shell(int k, double dx) const {
+  ShapeSample out;
+  std::vector<Vec3> mids, normals;
+  std::vector<double> areas;
+  std::vector<int> row_of;
+  leaflet_mid_surface(k, dx, mids, normals, &areas, &row_of);
+  // One orientation over the whole sheet: d_rho x d_s keeps its side on the regular (rho, s) patch; its sign
+  // is chosen so that the normal mid-belly points up the root (from the ventricle to the aorta).
+  const double e = 1e-6, inset = 0.5 * dx;
+  const Vec3 belly_n =
+      (leaflet_surface(k, 0.5 + e, 0.5, inset) - leaflet_surface(k, 0.5, 0.5, inset))
+          .cross(leaflet_surface(k, 0.5, 0.5 + e, inset) - leaflet_surface(k, 0.5, 0.5 - e, inset));
+  const double sign = belly_n.y() < 0 ? -1.0 : 1.0;
+  std::vector<std::size_t> kept, dropped;
+  for (std::size_t m = 0; m < mids.size(); ++m) {
+    const Vec3& q = mids[m];
+    const double r = std::hypot(q.x(), q.z()), th = std::atan2(-q.z(), q.x());
+    double s = 0.0;
+    const double depth = (lumen_radius(q.y(), th) - r) / normal_scale(q.y(), th);
+    if (sector_of(th, s) != k || sector_distance(r, s * dphi_[k], dphi_[k]) < kSectorMargin * dx ||
+        depth < kShellWallMargin * dx || q.y() < -p_.lvot_length + 0.5 * dx) {
+      dropped.push_back(m);
+      continue;
+    }
+    kept.push_back(m);
+    out.points.push_back(p_.base + q);
+    out.normals.push_back(sign * normals[m]);
+    out.areas.push_back(areas[m]);
+    out.clamped.push_back(row_of[m] == 0 || depth < kShellClampDepth * dx ? 1 : 0);
+  }
+  // A point left out hands its area to the nearest kept point, so the areas still tile the mid-surface.
+  for (std::size_t m : dropped) {
+    std::size_t best = 0;
+    double d2 = 1e300;
+    for (std::size_t j = 0; j < kept.size(); ++j) {
+      const double e2 = (mids[kept[j]] - mids[m]).squaredNorm();
+      if (e2 < d2) d2 = e2, best = j;
+    }
+    if (!kept.empty()) out.areas[best] += areas[m];
+  }
+  return out;
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Blood
 
@@ -503,20 +590,41 @@ std::vector<Vec3> AorticRoot::blood_points(double dx) const {
            (static_cast<int64_t>(c.z()) + (1 << 20));
   };
   double leaf_lo = 1e300, leaf_hi = -1e300;  // heights (relative to base) the leaflets span, +- dx
-  for (int k = 0; k < 3; ++k)
-    for (const Vec3& q : leaflet_points(k, dx, nullptr)) {
+  // Shell leaflets: the normals too (indexed like the grid's points).
+  std::unordered_map<int64_t, std::vector<Vec3>> grid_n;
+  for (int k = 0; k < 3; ++k) {
+    ShapeSample shell;
+    if (p_.shell_leaflets) shell = leaflet_shell(k, dx);
+    const std::vector<Vec3> pts = p_.shell_leaflets ? shell.points : leaflet_points(k, dx, nullptr);
+    for (std::size_t m = 0; m < pts.size(); ++m) {
+      const Vec3& q = pts[m];
       grid[cell(q)].push_back(q);
+      if (p_.shell_leaflets) grid_n[cell(q)].push_back(shell.normals[m]);
       leaf_lo = std::min(leaf_lo, q.y() - p_.base.y() - dx);
       leaf_hi = std::max(leaf_hi, q.y() - p_.base.y() + dx);
     }
+  }
   auto near_leaflet = [&](const Vec3& q) {
     for (int a = -1; a <= 1; ++a)
       for (int b = -1; b <= 1; ++b)
         for (int c = -1; c <= 1; ++c) {
-          const auto it = grid.find(cell(q + dx * Vec3(a, b, c)));
+          const int64_t key = cell(q + dx * Vec3(a, b, c));
+          const auto it = grid.find(key);
           if (it == grid.end()) continue;
-          for (const Vec3& o : it->second)
-            if ((o - q).squaredNorm() < kBloodGap * kBloodGap * dx * dx) return true;
+          for (std::size_t m = 0; m < it->second.size(); ++m) {
+            const Vec3 d = q - it->second[m];
+            if (!p_.shell_leaflets) {
+              if (d.squaredNorm() < kBloodGap * kBloodGap * dx * dx) return true;
+              continue;
+            }
+            // A shell is a sheet, not a row of balls: a point over a shell particle's patch (tangential
+            // offset < kShellPatch dx) must be kShellBloodGap dx off the sheet along its normal, and every
+            // point that far from the particle itself (round the free edges).
+            const double dn = std::abs(d.dot(grid_n[key][m]));
+            const double dt = (d - d.dot(grid_n[key][m]) * grid_n[key][m]).norm();
+            if (d.norm() < kShellBloodGap * dx || (dn < kShellBloodGap * dx && dt < kShellPatch * dx))
+              return true;
+          }
         }
     return false;
   };
@@ -638,7 +746,10 @@ ShapeSample sample_aortic_root(const AorticRootParams& p, AorticPart part, int l
       out.points = root.blood_points(dx);
       break;
     case AorticPart::Leaflet:
-      out.points = root.leaflet_points(std::clamp(leaflet, 0, 2), dx, &out.clamped);
+      if (p.shell_leaflets)
+        out = root.leaflet_shell(std::clamp(leaflet, 0, 2), dx);
+      else
+        out.points = root.leaflet_points(std::clamp(leaflet, 0, 2), dx, &out.clamped);
       break;
   }
   return out;

@@ -128,12 +128,24 @@ class AorticRoot {
 
   std::vector<Vec3> wall_points(double dx, SurfaceMesh* mesh) const;
   std::vector<Vec3> leaflet_points(int k, double dx, std::vector<uint8_t>* clamped) const;
+  // Shell leaflet k (issue 16; params().shell_leaflets): ONE layer of particles on the mid-surface the
+  // volumetric layers are centred on (the rows and points of leaflet_points, the same margins from the
+  // neighbouring sectors and the wall), with per point the unit normal (one orientation over the leaflet,
+  // from the ventricular to the aortic side: +y mid-belly), the surface element it stands for (areas sum to
+  // the mid-surface's area; a point left out near the wall hands its area on) and the clamp (the first row,
+  // at the attachment line, and what lies within 0.6 dx of the lumen surface; the sheet keeps 0.1 dx inside
+  // it).
+  ShapeSample leaflet_shell(int k, double dx) const;
   std::vector<Vec3> blood_points(double dx) const;
 
   Vec3 to_world(double r, double theta, double y) const;
 
  private:
   double midline_length(double sag) const;
+  // Leaflet k's mid-surface points (root frame, relative to base), row by row, with the unit normals
+  // d_rho x d_s (not oriented) and, if asked, the surface element of each point.
+  void leaflet_mid_surface(int k, double dx, std::vector<Vec3>& mids, std::vector<Vec3>& normals,
+                           std::vector<double>* areas, std::vector<int>* row_of) const;
   double bump(int k, double s, double y) const;
   // Mirror leaflets: signed distance of x (root frame) from leaflet k's attachment plane (positive on the
   // aortic side), the reflection across it, and the closed surface's height above (x, z).
