@@ -276,6 +276,15 @@ double World::stable_dt() const {
   // from the lists (stale right after particles were created or removed: then the bound waits a step).
   if (shell_contact_.active() && lists_valid_)
     dt = std::min(dt, shell_contact_.stable_dt(P_, nb_, shells_, ctx_.periodic, scene_.cfl));
+  // The contact forces are held over the shells' sub-steps: no sheet may move more than a quarter of the
+  // thinnest sheet's thickness (under the contact distance) in one step, or it could pass through a partner
+  // between two evaluations.
+  if (const double v = std::max(max_speed_, sub_.max_speed); shell_contact_.active() && v > 0.0) {
+    double t_min = std::numeric_limits<double>::max();
+    for (const Material& m : scene_.materials)
+      if (m.type == MaterialType::Shell) t_min = std::min(t_min, m.thickness);
+    dt = std::min(dt, 0.25 * t_min / v);
+  }
   // Viscous diffusion limit (Morris, Fox & Zhu 1997, eq. 18): dt <= 0.125 h^2 / nu.
   if (max_nu_ > 0.0) dt = std::min(dt, 0.125 * h * h / max_nu_);
   // Contact spring: two particles of mass m on a spring k touch for about pi sqrt(m / 2k) (m: see the
