@@ -14,7 +14,7 @@ namespace {
 // A uniform grid of cells of side `cell` over the points, for the searches within one cell's reach.
 class CellGrid {
  public:
-  CellGrid(const std::vector<Vec3>& X, double cell) : X_(X), inv_(1.0 / cell) {
+  CellGrid(const std::vector<Vec3>& X, double cell) : inv_(1.0 / cell) {
     for (uint32_t i = 0; i < X.size(); ++i) cells_[key(X[i])].push_back(i);
   }
   // Calls f(m) for every point in the 27 cells round p's cell (in a fixed order).
@@ -36,7 +36,6 @@ class CellGrid {
     return {std::lround(std::floor(p.x() * inv_)), std::lround(std::floor(p.y() * inv_)),
             std::lround(std::floor(p.z() * inv_))};
   }
-  const std::vector<Vec3>& X_;
   double inv_;
   std::map<Key, std::vector<uint32_t>> cells_;
 };
