@@ -44,7 +44,7 @@ Scene strip(double L, double t, double dx, double E, double rho, double max_dt) 
 
 }  // namespace
 
-TEST_CASE("shell sub-cycling: a large step gives the run of the shell's own step", "[shell][subcycle]") {
+TEST_CASE("shell sub-cycling: a large step gives the run of the shell's own step", "[shell][subcycle][long]") {
   const double L = 1.0, t = 0.1, dx = L / 20, E = 1e7, rho = 1000.0;
   const double f1 = 1.8751 * 1.8751 / (2 * std::numbers::pi * L * L) * std::sqrt(E * t * t / (12 * rho));
   const double T = 1.0 / f1, v0 = 1e-3 * L * 2 * std::numbers::pi * f1;
