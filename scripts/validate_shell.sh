@@ -5,7 +5,8 @@
 #   - the roll-up of a cantilever strip under an end moment 2 pi E I / L, and the Scordelis-Lo roof
 #     (tests/test_shell.cpp, hidden tag [.shell-validation]);
 #   - a water column on a clamped square plate (one side) and a plate window between two columns (both
-#     sides) against the clamped-plate formula (tests/test_shell_fluid.cpp, the same hidden tag).
+#     sides) against the clamped-plate formula (tests/test_shell_fluid.cpp), and the three shell aortic leaflets
+#     under 80 mmHg without fluid (tests/test_shell_leaflet.cpp), the same hidden tag.
 # Usage: scripts/validate_shell.sh   (BUILD_DIR=build, THREADS=1, OUT=out/validate_shell)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -290,9 +290,10 @@ TEST_CASE("shell leaflets: the scene loader builds shell bodies, bad input exits
   }
 }
 
+// A validation-size run (about 4 min on the loaded 2-core machine): hidden, run by scripts/validate_shell.sh.
 TEST_CASE(
     "shell leaflets: the closed valve under the diastolic load (80 mmHg on the aortic side) without fluid",
-    "[shell_leaflet][long]") {
+    "[.shell-validation][shell_leaflet]") {
   // Neo-Hookean leaflets, E = 1 MPa (the isotropic leaflet of Hsu et al. 2014, Comput. Mech. 54:1055), t =
   // 0.45 mm, rho = 1100; -10.7 kPa along the normal (which points to the aorta), ramped over 6 ms, damped
   // (2000 1/s, mass proportional) towards the static state. No wall and no contact: the leaflets are held by
