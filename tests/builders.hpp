@@ -44,6 +44,20 @@ inline Material wall() {
   return m;
 }
 
+// A one-layer shell material (sim/solid/shell.hpp) with the tests' hourglass coefficient 0.05.
+inline Material shell_sheet(double E, double nu, double t, double rho = 1000.0, double damping = 0.0) {
+  Material m;
+  m.name = "sheet";
+  m.type = MaterialType::Shell;
+  m.density = rho;
+  m.youngs_modulus = E;
+  m.poisson_ratio = nu;
+  m.thickness = t;
+  m.hourglass = 0.05;
+  m.shell_damping = damping;
+  return m;
+}
+
 inline Body box_body(const std::string& name, int material, Vec3 lo, Vec3 hi, Vec3 velocity = Vec3::Zero()) {
   Body b;
   b.name = name;

@@ -23,15 +23,7 @@ using namespace aortasph::test;
 namespace {
 
 Material shell_material(double E, double nu, double t, double rho = 1000.0) {
-  Material m;
-  m.name = "sheet";
-  m.type = MaterialType::Shell;
-  m.density = rho;
-  m.youngs_modulus = E;
-  m.poisson_ratio = nu;
-  m.thickness = t;
-  m.hourglass = 0.05;
-  return m;
+  return shell_sheet(E, nu, t, rho);
 }
 
 // An nx x ny lattice of shell particles in the xy-plane at spacing dx (normal +z), reference = current.

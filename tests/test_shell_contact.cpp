@@ -20,16 +20,7 @@ constexpr double kDamp = 1500.0;  // [1/s] the plates' velocity damping, so they
 constexpr double kK = 1e6;        // contact modulus: K = 100 p, the gap at p is d_c K / (K + p) = 0.990 d_c
 
 Material sheet_material(double damping) {
-  Material m;
-  m.name = "sheet";
-  m.type = MaterialType::Shell;
-  m.density = kRho;
-  m.youngs_modulus = kE;
-  m.poisson_ratio = 0.3;
-  m.thickness = kT;
-  m.hourglass = 0.05;
-  m.shell_damping = damping;
-  return m;
+  return shell_sheet(kE, 0.3, kT, kRho, damping);
 }
 
 Body plate(const std::string& name, int material, const Vec3& c, double a, double b, const Vec3& normal) {

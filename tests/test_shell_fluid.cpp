@@ -15,19 +15,6 @@ using namespace aortasph::test;
 
 namespace {
 
-Material sheet_material(double E, double nu, double t, double rho, double damping) {
-  Material m;
-  m.name = "sheet";
-  m.type = MaterialType::Shell;
-  m.density = rho;
-  m.youngs_modulus = E;
-  m.poisson_ratio = nu;
-  m.thickness = t;
-  m.hourglass = 0.05;
-  m.shell_damping = damping;
-  return m;
-}
-
 // A square sheet of side w at height y (normal +y) across a square shaft [0, w]^2 in x and z, its edge rows
 // (dx / 2 from the shaft's walls) clamped.
 Body clamped_sheet(int material, double w, double y, double dx) {
@@ -100,12 +87,13 @@ std::size_t wrong_side(const World& w, int body, bool above) {
 
 }  // namespace
 
-TEST_CASE("shell-fluid: a clamped stiff sheet holds a 10 kPa difference without a leak", "[shell_fluid][long]") {
+TEST_CASE("shell-fluid: a clamped stiff sheet holds a 10 kPa difference without a leak",
+          "[shell_fluid][long]") {
   // 1.02 m of water over a fixed sheet (rho g h = 10 kPa), a closed chamber of water below it. What is tested
   // is the fluid's side of the coupling: the column stands on the sheet as on a wall, and nothing of it, mass
   // or pressure, reaches the chamber.
   const double dx = 0.05, w = 0.3, y_sheet = 0.3, h_up = 1.02;
-  Scene s = sheet_in_shaft(w, y_sheet, h_up, dx, sheet_material(5e6, 0.3, 0.05, 1000.0, 20.0), 40.0);
+  Scene s = sheet_in_shaft(w, y_sheet, h_up, dx, shell_sheet(5e6, 0.3, 0.05, 1000.0, 20.0), 40.0);
   s.bodies[3].shell_fixed.push_back(Box{Vec3(-1, y_sheet - 0.01, -1), Vec3(1, y_sheet + 0.01, 1)});
   World world(s);
   REQUIRE(world.shells().size() == 36);
@@ -192,7 +180,7 @@ TEST_CASE("shell-fluid: a water column on a clamped plate deflects it as the sta
   // (span a = 0.3 m between them, a / t = 12), t = dx, E = 6.8 MPa, rho 8000 kg/m^3 (a plate wave no faster
   // than the fluid's sound), under 0.5 m of water plus its own weight.
   const double dx = 0.025, w = 13 * dx, a = 12 * dx, t = dx, E = 6.8e6, rho_s = 8000.0, H = 0.5;
-  Scene s = sheet_in_shaft(w, 0.0, H, dx, sheet_material(E, 0.3, t, rho_s, 200.0), 30.0);
+  Scene s = sheet_in_shaft(w, 0.0, H, dx, shell_sheet(E, 0.3, t, rho_s, 200.0), 30.0);
   s.bodies.erase(s.bodies.begin());  // nothing below the plate
   s.bodies[1].shape.open = {"+y", "-y"};
   s.bodies[1].shape.box.min.y() = -4 * dx;
@@ -231,7 +219,7 @@ TEST_CASE("shell-fluid: a plate between two water columns deflects by the net lo
   s.max_dt = 1e-3;
   s.cfl = 0.25;
   s.max_density_error = 0.05;
-  s.materials = {water(40.0), wall(), sheet_material(E, 0.3, t, 8000.0, 200.0)};
+  s.materials = {water(40.0), wall(), shell_sheet(E, 0.3, t, 8000.0, 200.0)};
   Body sheet;
   sheet.name = "divider";
   sheet.material = 2;
@@ -273,7 +261,7 @@ TEST_CASE("shell-fluid: 1 and 2 threads give bitwise the same run, and a checkpo
           "[shell_fluid][checkpoint]") {
   // An elastic sheet (edge rows clamped) between a column and a closed chamber: masks, labels, imaginary
   // particles and the guard all at work.
-  const Scene s = sheet_in_shaft(0.3, 0.3, 1.02, 0.05, sheet_material(5e6, 0.3, 0.05, 1000.0, 20.0), 40.0);
+  const Scene s = sheet_in_shaft(0.3, 0.3, 1.02, 0.05, shell_sheet(5e6, 0.3, 0.05, 1000.0, 20.0), 40.0);
   const int before = max_threads();
   uint64_t hash[2] = {0, 0};
   for (int k = 0; k < 2; ++k) {
@@ -312,7 +300,7 @@ TEST_CASE("shell-fluid: water passes round a free edge, not through the sheet be
   s.max_dt = 1e-3;
   s.cfl = 0.25;
   s.max_density_error = 0.05;
-  s.materials = {water(30.0), wall(), sheet_material(1e7, 0.3, 0.05, 1000.0, 0.0)};
+  s.materials = {water(30.0), wall(), shell_sheet(1e7, 0.3, 0.05, 1000.0, 0.0)};
   Body baffle;
   baffle.name = "baffle";
   baffle.material = 2;

@@ -5,9 +5,11 @@
 #include <cmath>
 #include <numbers>
 
+#include "builders.hpp"
 #include "world.hpp"
 
 using namespace aortasph;
+using aortasph::test::shell_sheet;
 
 namespace {
 
@@ -20,15 +22,7 @@ Scene strip(double L, double t, double dx, double E, double rho, double max_dt) 
   s.domain = {Vec3(-2 * L, -2 * L, -2 * L), Vec3(2 * L, 2 * L, 2 * L)};
   s.max_dt = max_dt;
   s.cfl = 0.5;
-  Material m;
-  m.name = "sheet";
-  m.type = MaterialType::Shell;
-  m.density = rho;
-  m.youngs_modulus = E;
-  m.poisson_ratio = 0.0;
-  m.thickness = t;
-  m.hourglass = 0.05;
-  s.materials = {m};
+  s.materials = {shell_sheet(E, 0.0, t, rho)};
   Body b;
   b.name = "strip";
   b.material = 0;
@@ -44,7 +38,8 @@ Scene strip(double L, double t, double dx, double E, double rho, double max_dt) 
 
 }  // namespace
 
-TEST_CASE("shell sub-cycling: a large step gives the run of the shell's own step", "[shell][subcycle][long]") {
+TEST_CASE("shell sub-cycling: a large step gives the run of the shell's own step",
+          "[shell][subcycle][long]") {
   const double L = 1.0, t = 0.1, dx = L / 20, E = 1e7, rho = 1000.0;
   const double f1 = 1.8751 * 1.8751 / (2 * std::numbers::pi * L * L) * std::sqrt(E * t * t / (12 * rho));
   const double T = 1.0 / f1, v0 = 1e-3 * L * 2 * std::numbers::pi * f1;
