@@ -15,6 +15,21 @@ using namespace aortasph::test;
 
 namespace {
 
+// A tank scene under gravity: water, walls and a sheet material; the domain is the tank [0, size] grown by
+// 0.5 m on every side.
+Scene tank_scene(const std::string& name, double dx, const Vec3& size, double c0, const Material& sheet) {
+  Scene s;
+  s.name = name;
+  s.spacing = dx;
+  s.gravity = Vec3(0, -9.81, 0);
+  s.domain = {Vec3(-0.5, -0.5, -0.5), Vec3(size.x() + 0.5, size.y() + 0.5, size.z() + 0.5)};
+  s.max_dt = 1e-3;
+  s.cfl = 0.25;
+  s.max_density_error = 0.05;
+  s.materials = {water(c0), wall(), sheet};
+  return s;
+}
+
 // A square sheet of side w at height y (normal +y) across a square shaft [0, w]^2 in x and z, its edge rows
 // (dx / 2 from the shaft's walls) clamped.
 Body clamped_sheet(int material, double w, double y, double dx) {
@@ -37,16 +52,8 @@ Body clamped_sheet(int material, double w, double y, double dx) {
 // A square shaft [0, w] x [0, top] x [0, w] (walls, open at the top) with water below a clamped sheet at
 // y = y_sheet (from the floor) and a column of height h_up above it.
 Scene sheet_in_shaft(double w, double y_sheet, double h_up, double dx, const Material& sheet, double c0) {
-  Scene s;
-  s.name = "sheet_in_shaft";
-  s.spacing = dx;
-  s.gravity = Vec3(0, -9.81, 0);
   const double top = y_sheet + h_up + 4 * dx;
-  s.domain = {Vec3(-0.5, -0.5, -0.5), Vec3(w + 0.5, top + 0.5, w + 0.5)};
-  s.max_dt = 1e-3;
-  s.cfl = 0.25;
-  s.max_density_error = 0.05;
-  s.materials = {water(c0), wall(), sheet};
+  Scene s = tank_scene("sheet_in_shaft", dx, Vec3(w, top, w), c0, sheet);
   s.bodies = {box_body("below", 0, Vec3(0, 0, 0), Vec3(w, y_sheet, w)),
               box_body("above", 0, Vec3(0, y_sheet, 0), Vec3(w, y_sheet + h_up, w)),
               container("shaft", 1, Vec3(0, 0, 0), Vec3(w, top, w), {"+y"}),
@@ -211,15 +218,8 @@ TEST_CASE("shell-fluid: a plate between two water columns deflects by the net lo
   // rho g (H1 - H2) = 2943 Pa, and it bulges to the right by the clamped-plate formula.
   const double dx = 0.025, L = 4 * dx, depth = 13 * dx, a = 12 * dx, t = dx, E = 4.0e6, H1 = 1.0, H2 = 0.7;
   const double y0 = 8.5 * dx, top = H1 + 4 * dx;  // fixed rows at y0 and y0 + a (on the lattice)
-  Scene s;
-  s.name = "two_columns";
-  s.spacing = dx;
-  s.gravity = Vec3(0, -9.81, 0);
-  s.domain = {Vec3(-0.5, -0.5, -0.5), Vec3(2 * L + 0.5, top + 0.5, depth + 0.5)};
-  s.max_dt = 1e-3;
-  s.cfl = 0.25;
-  s.max_density_error = 0.05;
-  s.materials = {water(40.0), wall(), shell_sheet(E, 0.3, t, 8000.0, 200.0)};
+  Scene s =
+      tank_scene("two_columns", dx, Vec3(2 * L, top, depth), 40.0, shell_sheet(E, 0.3, t, 8000.0, 200.0));
   Body sheet;
   sheet.name = "divider";
   sheet.material = 2;
@@ -292,15 +292,7 @@ TEST_CASE("shell-fluid: water passes round a free edge, not through the sheet be
   // 0.6 m deep on the left, 0.3 m on the right flows under the edge and the levels approach each other;
   // every particle that changes side does so below the edge.
   const double dx = 0.05, L = 0.3, depth = 0.2, gap = 3 * dx, H1 = 0.6, H2 = 0.3, top = 0.8;
-  Scene s;
-  s.name = "sluice";
-  s.spacing = dx;
-  s.gravity = Vec3(0, -9.81, 0);
-  s.domain = {Vec3(-0.5, -0.5, -0.5), Vec3(2 * L + 0.5, top + 0.5, depth + 0.5)};
-  s.max_dt = 1e-3;
-  s.cfl = 0.25;
-  s.max_density_error = 0.05;
-  s.materials = {water(30.0), wall(), shell_sheet(1e7, 0.3, 0.05, 1000.0, 0.0)};
+  Scene s = tank_scene("sluice", dx, Vec3(2 * L, top, depth), 30.0, shell_sheet(1e7, 0.3, 0.05, 1000.0, 0.0));
   Body baffle;
   baffle.name = "baffle";
   baffle.material = 2;
