@@ -238,6 +238,8 @@ World::World(const Scene& scene)
         {scene_.contact.shell_stiffness, scene_.contact.shell_margin, scene_.contact.shell_damping, dx},
         kernel_.support);
     contact_.skip_shells = shell_contact_.active();  // the shells' own contact replaces eqs. 23-25 there
+    for (const Material& m : scene_.materials)
+      if (m.type == MaterialType::Shell) min_shell_thickness_ = std::min(min_shell_thickness_, m.thickness);
     if (have_fluid) {  // fluid on either side of a sheet (sim/boundary/shell_coupling.hpp)
       coupling_ = ShellCoupling(P_, shells_, dx, kernel_.support, wall_ref_.rho0);
       ctx_.shell_wall = &coupling_.wall();
@@ -279,12 +281,8 @@ double World::stable_dt() const {
   // The contact forces are held over the shells' sub-steps: no sheet may move more than a quarter of the
   // thinnest sheet's thickness (under the contact distance) in one step, or it could pass through a partner
   // between two evaluations.
-  if (const double v = std::max(max_speed_, sub_.max_speed); shell_contact_.active() && v > 0.0) {
-    double t_min = std::numeric_limits<double>::max();
-    for (const Material& m : scene_.materials)
-      if (m.type == MaterialType::Shell) t_min = std::min(t_min, m.thickness);
-    dt = std::min(dt, 0.25 * t_min / v);
-  }
+  if (const double v = std::max(max_speed_, sub_.max_speed); shell_contact_.active() && v > 0.0)
+    dt = std::min(dt, 0.25 * min_shell_thickness_ / v);
   // Viscous diffusion limit (Morris, Fox & Zhu 1997, eq. 18): dt <= 0.125 h^2 / nu.
   if (max_nu_ > 0.0) dt = std::min(dt, 0.125 * h * h / max_nu_);
   // Contact spring: two particles of mass m on a spring k touch for about pi sqrt(m / 2k) (m: see the

@@ -21,8 +21,8 @@
 #include "rigid/rigid_body.hpp"
 #include "scene.hpp"
 #include "solid/shell.hpp"
-#include "solid/shell_mesh.hpp"
 #include "solid/shell_contact.hpp"
+#include "solid/shell_mesh.hpp"
 #include "solid/solid_tlsph.hpp"
 
 namespace aortasph {
@@ -224,6 +224,7 @@ class World {
   } sub_;
   OpenBoundaries open_;  // inflows and outflows; their counters are plain values (OpenBoundaryState)
   ContactParams contact_;
+  double min_shell_thickness_ = std::numeric_limits<double>::max();  // the step bound under shell contact
   ShellContact shell_contact_;  // sheets against sheets and walls (active when contact.shell_stiffness > 0)
   double min_contact_mass_ = std::numeric_limits<double>::max();
   std::vector<Vec3> force_;   // per-particle force on body particles of the current step
