@@ -154,7 +154,9 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
     const double len = m.norm();
     if (len > 0.0) edge_out_[i] = -m / len;
   });
-  // Rows as built, then the labels.
+  // Rows as built, then the labels (also the imaginary particles' side for each fluid particle: outside the
+  // band it has none).
+  wall_.sides.assign(n, ShellWall::Sides{});
   uint32_t* rows = nb.row_data();
   x_before_.resize(band_.size());
   parallel_for(band_.size(), [&](std::size_t r) {
@@ -188,6 +190,12 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
     }
     labels_[r] = L;
     x_before_[r] = P.x[i];
+    ShellWall::Sides& S = wall_.sides[i];
+    S.n = L.n;
+    for (uint8_t q = 0; q < L.n; ++q) {
+      S.body[q] = L.l[q].body;
+      S.side[q] = L.l[q].side;
+    }
   });
   // Masks: each row partitioned into kept pairs, local walls and masked pairs, each in their built order. A
   // fixed wall particle across a sheet from a fluid particle is a "local wall" for it (fluid/shell_wall.hpp:

@@ -68,7 +68,7 @@ class ShellCoupling {
     int8_t side = 0;  // +1 / -1
     uint8_t edge = 0;
   };
-  static constexpr int kLabels = 4;
+  static constexpr int kLabels = ShellWall::kSides;
   struct Labels {
     std::array<Label, kLabels> l;
     uint8_t n = 0;

@@ -19,7 +19,8 @@ void fluid_density_summation(Particles& P, const NeighborSearch& nb, const Fluid
       const Vec3 xij = ctx.separation(P.x[i], P.x[j]);
       if (ctx.shell_wall && P.kind[j] == Kind::Shell) {  // the shell's imaginary wall particles
         const ShellWall& sw = *ctx.shell_wall;
-        sw.for_each_ghost(xij, j, [&](const Vec3& r) { rho += sw.ghost_mass[j] * ctx.kernel.W(r.norm()); });
+        sw.for_each_ghost(xij, i, j, P.body[j],
+                          [&](const Vec3& r) { rho += sw.ghost_mass[j] * ctx.kernel.W(r.norm()); });
         continue;
       }
       rho += P.m[j] * ctx.kernel.W(xij.norm());
@@ -67,7 +68,7 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
         // The shell's imaginary wall particles move with the shell (fluid/shell_wall.hpp).
         const ShellWall& sw = *ctx.shell_wall;
         const Vec3 vij = vi - P.v[j];
-        sw.for_each_ghost(xij, j, [&](const Vec3& rg) {
+        sw.for_each_ghost(xij, i, j, P.body[j], [&](const Vec3& rg) {
           const double rg2 = rg.squaredNorm();
           if (rg2 >= support2) return;
           const double rr = std::sqrt(rg2);
@@ -156,8 +157,9 @@ inline Vec3 shell_acceleration(const Particles& P, const FluidContext& ctx, cons
   const Vec3 vij = I.v - P.v[j];
   const Vec3 g_minus_a = ctx.gravity - P.a[j];
   Vec3 acc = Vec3::Zero();
-  sw.for_each_ghost(
-      xij, j, [&](const Vec3& rg) { acc += local_wall_term(ctx, c, I, rg, mg, vij, g_minus_a, background); });
+  sw.for_each_ghost(xij, I.i, j, P.body[j], [&](const Vec3& rg) {
+    acc += local_wall_term(ctx, c, I, rg, mg, vij, g_minus_a, background);
+  });
   return acc;
 }
 

@@ -3,7 +3,7 @@
 //
 // A shell particle j (mid-surface point x_j, unit director n_j, reference area A_j) stands, for a fluid
 // particle i, for a stack of imaginary wall particles on the side away from i: at
-//     x_g,k = x_j - sigma (k - 1/2) dx n_j,   k = 1 .. K,   sigma = sign(n_j . (x_i - x_j)),
+//     x_g,k = x_j - sigma (k - 1/2) dx n_j,   k = 1 .. K,   sigma = i's side of the sheet (sigma() below),
 // each of volume A_j dx (a wall slab of thickness dx behind the mid-surface, K dx covering the kernel
 // support), so that i's kernel support is as full as next to a plain wall of layered particles. This is
 // the ghost stacking of SPHinXsys's fluid-shell coupling (Wu, Zhang & Hu; /work/shared/reference/shell.md
@@ -18,6 +18,7 @@
 // (sim/boundary/ shell_coupling.hpp).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -34,16 +35,41 @@ struct ShellWall {
   // the imaginary particles. kNoLocal: none.
   static constexpr uint32_t kNoLocal = 0xffffffffu;
   std::vector<uint32_t> local_begin;
+  // By particle: the fluid particle's side of each shell body near it, from its side label this step
+  // (sim/boundary/shell_coupling.hpp; the sign of n_s . (x_i - x_s) for the body's nearest particle s).
+  static constexpr int kSides = 4;
+  struct Sides {
+    std::array<uint16_t, kSides> body{};
+    std::array<int8_t, kSides> side{};
+    uint8_t n = 0;
+  };
+  std::vector<Sides> sides;
   double dx = 0.0;  // layer spacing
   int layers = 0;   // K
 
-  // Calls f(r_ig) with r_ig = x_i - x_g for each imaginary particle of shell particle j seen from i, where
-  // xij = x_i - x_j.
+  // The side sigma on which fluid particle i sees the sheet of body `body_j` near shell particle j: its
+  // label for that body when it has one, otherwise the side of j's own tangent plane. The label, not the
+  // pair's geometry, decides: with the geometric sign a fluid particle that drifts into the plane of a
+  // particle near a free edge (n_j . x_ij ~ 0) is pushed on by the imaginary particles to whichever side it
+  // happens to be on, an unstable balance that let fluid slip through the last half spacing of a sheet;
+  // with the label it is pushed back to its own side, and all of a sheet's particles present their wall on
+  // the same side of a fluid particle, also where the sheet curves.
+  double sigma(const Vec3& xij, std::size_t i, std::size_t j, uint16_t body_j) const {
+    if (i < sides.size()) {
+      const Sides& S = sides[i];
+      for (uint8_t q = 0; q < S.n; ++q)
+        if (S.body[q] == body_j) return S.side[q];
+    }
+    return normal[j].dot(xij) >= 0.0 ? 1.0 : -1.0;
+  }
+
+  // Calls f(r_ig) with r_ig = x_i - x_g for each imaginary particle of shell particle j (of body body_j)
+  // seen from fluid particle i, where xij = x_i - x_j.
   template <class F>
-  void for_each_ghost(const Vec3& xij, std::size_t j, F&& f) const {
+  void for_each_ghost(const Vec3& xij, std::size_t i, std::size_t j, uint16_t body_j, F&& f) const {
     const Vec3& n = normal[j];
-    const double sigma = n.dot(xij) >= 0.0 ? 1.0 : -1.0;
-    for (int k = 1; k <= layers; ++k) f(Vec3(xij + (sigma * (k - 0.5) * dx) * n));
+    const double s = sigma(xij, i, j, body_j);
+    for (int k = 1; k <= layers; ++k) f(Vec3(xij + (s * (k - 0.5) * dx) * n));
   }
 };
 
