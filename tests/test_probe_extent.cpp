@@ -11,9 +11,10 @@ using namespace aortasph::test;
 
 namespace {
 
-// A 10 x 10 x 4 block of water (Δx = 0.01 m, particles at x = 0.005 .. 0.095) and, ahead of it along x, a
-// blob of 2 x 2 x 2 particles centred 6 Δx past the block's edge and one particle 16 Δx past it: droplets
-// well beyond the kernel support (2h = 2.6 Δx) of the block and of each other. No gravity, no walls.
+// A 10 x 10 x 4 block of water (Δx = 0.01 m, particles at x = 0.005 .. 0.095, its edge at 0.1) and, ahead of
+// it along x, a blob of 2 x 2 x 2 particles centred 6 Δx past the block's edge and one particle 16 Δx past
+// it: droplets well beyond the kernel support (2h = 2.6 Δx) of the block and of each other. No gravity, no
+// walls.
 Scene block_and_droplets() {
   Scene s;
   s.name = "extent_test";
@@ -47,7 +48,7 @@ TEST_CASE("extent probe: max sees the furthest droplet, extent the edge of the c
     const auto v = probes.measure(w);
     REQUIRE(v.size() == 2);
     CHECK(v[0] == Approx(0.255).margin(1e-9));  // the lone droplet
-    CHECK(v[1] == Approx(0.095).margin(1e-9));  // the block's last layer
+    CHECK(v[1] == Approx(0.1).margin(1e-9));    // the block's edge: its last layer + dx/2
   }
   // A droplet within the link distance of the block belongs to the continuous fluid: one particle 2 Δx
   // past the block's edge (closer than 2h = 2.6 Δx) moves the edge to it; with a link of 1.5 Δx it is a
@@ -58,13 +59,13 @@ TEST_CASE("extent probe: max sees the furthest droplet, extent the edge of the c
     const World w(s);
     const auto v = ProbeSet(s, w).measure(w);
     CHECK(v[0] == Approx(0.255).margin(1e-9));
-    CHECK(v[1] == Approx(0.115).margin(1e-9));
+    CHECK(v[1] == Approx(0.12).margin(1e-9));
   }
   s.probes[1].link = 1.5 * s.spacing;
   {
     const World w(s);
     const auto v = ProbeSet(s, w).measure(w);
-    CHECK(v[1] == Approx(0.095).margin(1e-9));
+    CHECK(v[1] == Approx(0.1).margin(1e-9));
   }
   // The largest cluster decides, wherever it lies: a region that keeps only the blob and the droplet
   // measures the blob (8 particles against 1), not the droplet beyond it.
@@ -73,7 +74,7 @@ TEST_CASE("extent probe: max sees the furthest droplet, extent the edge of the c
   {
     const World w(s);
     const auto v = ProbeSet(s, w).measure(w);
-    CHECK(v[1] == Approx(0.165).margin(1e-9));
+    CHECK(v[1] == Approx(0.17).margin(1e-9));
   }
 }
 
@@ -100,6 +101,6 @@ TEST_CASE("extent probe: the continuous-fluid edge is the same for 1 and 2 threa
   REQUIRE(out[0].size() == 2);
   CHECK(out[0][0] == out[1][0]);
   CHECK(out[0][1] == out[1][1]);
-  CHECK(out[0][1] <= out[0][0]);
+  CHECK(out[0][1] <= out[0][0] + 0.5 * s.spacing);
   CHECK(out[0][1] > 0.05715 / 2);  // the column, not nothing
 }

@@ -77,7 +77,8 @@ GapStats body_gap(const World& world, const std::vector<int>& bodies) {
 // docs/scenes.md): the particles of the listed bodies inside the region are linked when closer than `link`
 // (by default the kernel support 2h: farther apart, two particles exchange no force, so a cluster cut off at
 // that distance moves on its own, under gravity only: a droplet or a spray). The answer is the largest
-// coordinate of the largest cluster (most particles; among equal largest clusters, the furthest). Clusters
+// coordinate of the largest cluster (most particles; among equal largest clusters, the furthest), plus half a
+// spacing: the edge of the fluid the particles stand for, not the last particle's centre. Clusters
 // by union-find over the pairs of a NeighborSearch, visited in its fixed order; the result is a count and a
 // maximum, so it does not depend on the visiting order or the thread count. NaN over no particle.
 double continuous_extent(const World& world, const Probe& pr) {
@@ -116,7 +117,10 @@ double continuous_extent(const World& world, const Probe& pr) {
       best_count = count[r];
       best = top[r];
     }
-  return best;
+  // A particle stands for the cube of side dx around it: the fluid's edge is half a spacing beyond the last
+  // particle's centre (as where World sets the free surface of a fluid body at rest), so a column of side a
+  // measures a at t = 0, at any resolution.
+  return best + 0.5 * world.scene().spacing;
 }
 
 // Largest eigenvalue of the Green-Lagrange strain E = (F^T F - I) / 2 (paper eq. 15).
