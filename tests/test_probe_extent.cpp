@@ -5,6 +5,7 @@
 #include "builders.hpp"
 #include "core/parallel.hpp"
 #include "io/probes.hpp"
+#include "scene_loader.hpp"
 
 using namespace aortasph;
 using namespace aortasph::test;
@@ -103,4 +104,32 @@ TEST_CASE("extent probe: the continuous-fluid edge is the same for 1 and 2 threa
   CHECK(out[0][1] == out[1][1]);
   CHECK(out[0][1] <= out[0][0] + 0.5 * s.spacing);
   CHECK(out[0][1] > 0.05715 / 2);  // the column, not nothing
+}
+
+TEST_CASE("extent probe: the loader reads \"stat\": \"extent\" and its link", "[probes][front][scene]") {
+  const auto j = nlohmann::json::parse(R"({
+    "name": "t",
+    "domain": { "min": [-1, -1, -1], "max": [1, 1, 1] },
+    "resolution": { "spacing": 0.01 },
+    "time": { "end": 0.1, "output_interval": 0.01 },
+    "materials": { "water": { "type": "fluid", "density": 1000, "viscosity": 1e-6, "sound_speed": 20 } },
+    "bodies": [ { "name": "a", "material": "water", "shape": { "box": { "min": [0, 0, 0], "max": [0.1, 0.1, 0.1] } } } ],
+    "probes": [ { "name": "m", "type": "extent", "bodies": ["a"], "axis": "x", "stat": "max" },
+                { "name": "e", "type": "extent", "bodies": ["a"], "axis": "y", "stat": "extent" },
+                { "name": "l", "type": "extent", "bodies": ["a"], "axis": "z", "stat": "extent", "link": 0.015 } ]
+  })");
+  const Scene s = load_scene_json(j, {}).scene;
+  REQUIRE(s.probes.size() == 3);
+  CHECK_FALSE(s.probes[0].stat_extent);
+  CHECK(s.probes[1].stat_extent);
+  CHECK(s.probes[1].stat_max);
+  CHECK(s.probes[1].link == 0.0);  // the kernel support
+  CHECK(s.probes[2].stat_extent);
+  CHECK(s.probes[2].link == 0.015);
+  // The block's edge along each axis: 0.1 m (its last particle at 0.095 m).
+  const World w(s);
+  const auto v = ProbeSet(s, w).measure(w);
+  CHECK(v[0] == Approx(0.095).margin(1e-12));
+  CHECK(v[1] == Approx(0.1).margin(1e-12));
+  CHECK(v[2] == Approx(0.1).margin(1e-12));
 }

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "builders.hpp"
+#include "scene_loader.hpp"
 
 using namespace aortasph;
 using namespace aortasph::test;
@@ -82,4 +83,27 @@ TEST_CASE("free-slip plates: a force-driven channel moves as a plug; no-slip pla
   // nu t / L^2 = 0.2), slow next to the plates, and the mean far below F t.
   CHECK(ns.mean / plug < 0.5);
   CHECK(ns.centre / ns.wall > 2.0);
+}
+
+TEST_CASE("the loader reads a body's slip condition; no slip by default", "[wall-slip][scene]") {
+  const auto j = nlohmann::json::parse(R"({
+    "name": "t",
+    "domain": { "min": [-1, -1, -1], "max": [1, 1, 1] },
+    "resolution": { "spacing": 0.01 },
+    "time": { "end": 0.1, "output_interval": 0.01 },
+    "materials": { "water": { "type": "fluid", "density": 1000, "viscosity": 1e-6, "sound_speed": 20 },
+                   "wall": { "type": "wall" } },
+    "bodies": [ { "name": "a", "material": "water", "shape": { "box": { "min": [0, 0, 0], "max": [0.1, 0.1, 0.1] } } },
+                { "name": "floor", "material": "wall", "slip": "free_slip",
+                  "shape": { "box": { "min": [0, -0.03, 0], "max": [0.1, 0, 0.1] } } },
+                { "name": "side", "material": "wall", "slip": "no_slip",
+                  "shape": { "box": { "min": [-0.03, 0, 0], "max": [0, 0.1, 0.1] } } },
+                { "name": "back", "material": "wall",
+                  "shape": { "box": { "min": [0.1, 0, 0], "max": [0.13, 0.1, 0.1] } } } ]
+  })");
+  const Scene s = load_scene_json(j, {}).scene;
+  REQUIRE(s.bodies.size() == 4);
+  CHECK(s.bodies[1].free_slip);
+  CHECK_FALSE(s.bodies[2].free_slip);
+  CHECK_FALSE(s.bodies[3].free_slip);
 }
