@@ -9,7 +9,7 @@ of any water particle (`stat: max`), the continuous-fluid edge with the default 
 link 1.5 dx. Prints Z and its error against the tabulated front (Table 2/6) at each tabulated 1 <= T <= 3.
 
 usage: scripts/dambreak_front.py BINARY OUTDIR [--div 10] [--slip no_slip|free_slip] [--delta 0.1]
-                                 [--depth 4] [--smoothing 1.3] [--c0-factor 10] [--threads 2]
+                                 [--depth 4] [--smoothing 1.3] [--c0-factor 10] [--gate 0] [--threads 2]
                                  [--end-T 3.0] [--shift 0]
 """
 import argparse
@@ -35,7 +35,7 @@ def reference():
     return rows
 
 
-def scene(a, div, slip, delta, depth_layers, end_t, smoothing, c0_factor):
+def scene(a, div, slip, delta, depth_layers, end_t, smoothing, c0_factor, gate):
     dx = a / div
     depth = depth_layers * dx
     c0 = c0_factor * math.sqrt(2 * 9.81 * 2 * a)
@@ -43,17 +43,27 @@ def scene(a, div, slip, delta, depth_layers, end_t, smoothing, c0_factor):
             "shape": {"container": {"min": [0, 0, 0], "max": [8 * a, 3 * a, depth], "layers": 3, "open": ["+y"]}}}
     if slip != "no_slip":
         tank["slip"] = slip
+    bodies = [{"name": "column", "material": "water",
+               "shape": {"box": {"min": [0, 0, 0], "max": [a, 2 * a, depth]}}}, tank]
+    materials = {"water": {"type": "fluid", "density": 1000, "viscosity": 1e-6, "sound_speed": c0,
+                           "delta_sph": delta},
+                 "wall": {"type": "wall"}}
+    top = 3 * a + 0.05
+    if gate > 0:
+        # A gate two spacings thick against the column's face, lifted at `gate` m/s from t = 0: a rigid body
+        # so dense (1e5 kg/m^3) that the water's push hardly changes its motion (gravity slows it by g t).
+        materials["gate"] = {"type": "rigid", "density": 1e5}
+        bodies.append({"name": "gate", "material": "gate", "velocity": [0, gate, 0],
+                       "shape": {"box": {"min": [a, 0, 0], "max": [a + 2 * dx, 2.2 * a, depth]}}})
+        top = 2.2 * a + gate * end_t + 0.1
     return {
         "name": "dambreak_front",
-        "domain": {"min": [-0.05, -0.05, -0.05], "max": [8 * a + 0.05, 3 * a + 0.05, depth + 0.05]},
+        "domain": {"min": [-0.05, -0.05, -0.05], "max": [8 * a + 0.05, top, depth + 0.05]},
         "resolution": {"spacing": dx, "smoothing_ratio": smoothing},
         "time": {"end": end_t, "output_interval": 0.001, "cfl": 0.25, "max_dt": 1e-3},
         "gravity": [0, -9.81, 0],
-        "materials": {"water": {"type": "fluid", "density": 1000, "viscosity": 1e-6, "sound_speed": c0,
-                                "delta_sph": delta},
-                      "wall": {"type": "wall"}},
-        "bodies": [{"name": "column", "material": "water",
-                    "shape": {"box": {"min": [0, 0, 0], "max": [a, 2 * a, depth]}}}, tank],
+        "materials": materials,
+        "bodies": bodies,
         "probes": [
             {"name": "max", "type": "extent", "bodies": ["column"], "axis": "x", "stat": "max"},
             {"name": "extent", "type": "extent", "bodies": ["column"], "axis": "x", "stat": "extent"},
@@ -73,6 +83,7 @@ def main():
     ap.add_argument("--depth", type=int, default=4)
     ap.add_argument("--smoothing", type=float, default=1.3)
     ap.add_argument("--c0-factor", type=float, default=10.0, help="c0 over sqrt(2 g H), H = 2a")
+    ap.add_argument("--gate", type=float, default=0.0, help="lift a gate at this speed [m/s] (0: no gate)")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--end-T", type=float, default=3.0)
     ap.add_argument("--shift", type=float, default=0.0, help="report Z(T - shift) as well (time origin)")
@@ -83,7 +94,7 @@ def main():
     path = os.path.join(args.out, "scene.json")
     with open(path, "w") as f:
         json.dump(scene(a, args.div, args.slip, args.delta, args.depth, args.end_T / scale + 0.002,
-                        args.smoothing, args.c0_factor), f, indent=1)
+                        args.smoothing, args.c0_factor, args.gate), f, indent=1)
     if not os.path.exists(os.path.join(args.out, "probes.csv")):
         subprocess.run([args.binary, "run", path, "--out", args.out, "--no-render", "--quiet", "--threads",
                         str(args.threads)], check=True)
@@ -100,7 +111,7 @@ def main():
         return float("nan")
 
     print(f"# div {args.div} slip {args.slip} delta {args.delta} depth {args.depth} smoothing {args.smoothing} "
-          f"c0 {args.c0_factor} sqrt(2gH)")
+          f"c0 {args.c0_factor} sqrt(2gH) gate {args.gate} m/s")
     print("T,Z_exp,Z_max,err_max,Z_extent,err_extent,Z_extent15,err_extent15" +
           (",Z_max_shifted,err_shifted" if args.shift else ""))
     for T, Z in reference():

@@ -23,3 +23,5 @@ run a20_delta0 --div 20 --delta 0
 run a10_depth8 --div 10 --depth 8
 run a10_c0x2 --div 10 --c0-factor 20
 run a10_h16 --div 10 --smoothing 1.6
+run a10_gate1 --div 10 --gate 1
+run a10_gate2 --div 10 --gate 2
