@@ -525,7 +525,7 @@ class Loader {
   Body body(json& j, const std::string& path, const Scene& s) {
     Obj o(j, path,
           {"name", "material", "shape", "translate", "rotate", "velocity", "angular_velocity", "color",
-           "render", "fixed", "initial_flow", "pinned", "pressure_load"},
+           "render", "fixed", "initial_flow", "pinned", "pressure_load", "slip"},
           allowed);
     Body b;
     b.name = o.string("name");
@@ -554,6 +554,12 @@ class Loader {
     }
     b.velocity = o.vec3("velocity", Vec3::Zero());
     b.angular_velocity = o.vec3("angular_velocity", Vec3::Zero());
+    if (o.has("slip")) {  // the viscous wall condition (issue 20): no_slip (default) or free_slip
+      const MaterialType t = s.materials[b.material].type;
+      if (t != MaterialType::Wall && t != MaterialType::Rigid && t != MaterialType::Elastic)
+        fail(o.path("slip"), "only a wall, rigid or elastic body takes a slip condition");
+      b.free_slip = o.choice("slip", {"no_slip", "free_slip"}) == "free_slip";
+    }
     if (o.has("initial_flow")) {
       if (s.materials[b.material].type != MaterialType::Fluid)
         fail(o.path("initial_flow"), "only a fluid body takes an initial flow field");
@@ -891,7 +897,7 @@ class Loader {
     if (!j.is_object()) fail(path, "expected an object, got " + type_name(j));
     const std::string type = j.contains("type") && j["type"].is_string() ? j["type"].get<std::string>() : "";
     std::vector<std::string> keys = {"name", "type"};
-    if (type == "extent") keys.insert(keys.end(), {"bodies", "axis", "stat", "region"});
+    if (type == "extent") keys.insert(keys.end(), {"bodies", "axis", "stat", "region", "link"});
     if (type == "pressure") keys.insert(keys.end(), {"point"});
     if (type == "body") keys.insert(keys.end(), {"body"});
     if (type == "point") keys.insert(keys.end(), {"body", "reference"});
@@ -918,7 +924,11 @@ class Loader {
         p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
       const std::string axis = o.choice("axis", {"x", "y", "z"});
       p.axis = axis[0] - 'x';
-      p.stat_max = o.choice("stat", {"max", "min"}) == "max";
+      const std::string stat = o.choice("stat", {"max", "min", "extent"});
+      p.stat_max = stat != "min";
+      p.stat_extent = stat == "extent";
+      if (o.has("link") && !p.stat_extent) fail(o.path("link"), "only for \"stat\": \"extent\"");
+      if (o.has("link")) p.link = o.positive("link");
       if (o.has("region")) {
         Obj r(o.raw("region"), o.path("region"), {"min", "max"}, allowed);
         p.region = r.box();

@@ -177,6 +177,9 @@ struct Body {
   // Shell bodies: supports (each a list of boxes): fixed holds position and director, pinned the position.
   std::vector<Box> shell_fixed, shell_pinned;
   std::optional<TimeSeries> pressure_load;  // shell bodies: pressure along the normal [Pa]
+  // Wall, rigid and elastic bodies, `"slip": "free_slip"` (issue 20): no viscous shear between the fluid and
+  // the body's particles (fluid/fluid_wcsph.cpp); default no slip (Adami et al. 2012, eq. 22).
+  bool free_slip = false;
 };
 
 struct Contact {
@@ -215,6 +218,10 @@ struct Probe {
   int body = -1;            // body, point, orifice_area
   int axis = 0;             // extent: 0,1,2 = x,y,z
   bool stat_max = true;     // extent: max or min
+  // extent, `"stat": "extent"`: the largest coordinate of the continuous fluid (the largest cluster of
+  // particles linked closer than `link`, sim/io/probes.cpp) instead of the largest of any particle.
+  bool stat_extent = false;
+  double link = 0.0;  // extent: link distance [m]; 0: the kernel support 2h
   std::optional<Box> region;
   Vec3 point = Vec3::Zero();      // pressure, flow_rate, orifice_area
   Vec3 normal = Vec3::UnitY();    // flow_rate, orifice_area

@@ -182,6 +182,12 @@ World::World(const Scene& scene)
     }
     bodies_.push_back(std::move(info));
   }
+  // Free-slip boundary bodies (Body::free_slip): left out of the fluid's viscous term.
+  for (std::size_t b = 0; b < scene_.bodies.size(); ++b)
+    if (scene_.bodies[b].free_slip) {
+      ctx_.free_slip.resize(scene_.bodies.size(), 0);
+      ctx_.free_slip[b] = 1;
+    }
   contact_ = ContactParams{scene_.contact.stiffness,
                            scene_.contact.damping,
                            scene_.contact.shear,

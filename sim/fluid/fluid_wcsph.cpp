@@ -199,9 +199,13 @@ inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx, const
   // Viscosity, eq. (10), in the form symmetric in i and j (Morris, Fox & Zhu 1997, eq. 8): 2/rho_j becomes
   // 1/rho_i + 1/rho_j, equal to eq. (10) at uniform density and exactly momentum conserving. Boundary
   // particles use their extrapolated no-slip velocity (Adami et al. 2012, eq. 22): a moving wall's velocity
-  // enters the viscous force here.
+  // enters the viscous force here. A free-slip body (Body::free_slip) is left out of the viscous sum: Adami
+  // et al. impose no slip only through this term (the eq. 22 velocity enters nowhere else; the continuity
+  // equation uses the wall's own velocity), so without it no shear stress reaches the fluid from the body's
+  // surface. Its pressure term is unchanged, so the body still holds the fluid out; artificial viscosity, a
+  // shock-capturing dissipation of approaching pairs, is unchanged too.
   const double nu = fluid_j ? 0.5 * (fi.nu + ctx.params[P.material[j]].nu) : fi.nu;
-  if (nu > 0.0) {
+  if (nu > 0.0 && (fluid_j || !ctx.free_slip_of(P.body[j]))) {
     const Vec3 vij_visc = fluid_j ? vij : Vec3(I.v - P.v_wall[j]);
     const double f = nu * mj * (1.0 / rhoi + 1.0 / rhoj) * (r * dwdr) / (r2 + eta2);
     acc += f * vij_visc;

@@ -64,6 +64,10 @@ struct FluidContext {
   Periodic periodic;                // periodic axes: pair separations are nearest images
   // Shells seen as two-sided walls (fluid/shell_wall.hpp); null when the scene has no shell beside a fluid.
   const ShellWall* shell_wall = nullptr;
+  // Per body: 1 for a free-slip boundary body (Body::free_slip), whose particles take no part in the
+  // viscous term; empty when every body is no-slip.
+  std::vector<uint8_t> free_slip = {};
+  bool free_slip_of(uint32_t body) const { return !free_slip.empty() && free_slip[body]; }
   // x_i - x_j, or its nearest image along periodic axes.
   Vec3 separation(const Vec3& xi, const Vec3& xj) const {
     return periodic.any ? periodic.image(xi - xj) : Vec3(xi - xj);

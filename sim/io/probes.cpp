@@ -73,6 +73,56 @@ GapStats body_gap(const World& world, const std::vector<int>& bodies) {
   return g;
 }
 
+// The leading edge of the continuous fluid along `axis` (an `extent` probe with "stat": "extent",
+// docs/scenes.md): the particles of the listed bodies inside the region are linked when closer than `link`
+// (by default the kernel support 2h: farther apart, two particles exchange no force, so a cluster cut off at
+// that distance moves on its own, under gravity only: a droplet or a spray). The answer is the largest
+// coordinate of the largest cluster (most particles; among equal largest clusters, the furthest), plus half a
+// spacing: the edge of the fluid the particles stand for, not the last particle's centre. Clusters
+// by union-find over the pairs of a NeighborSearch, visited in its fixed order; the result is a count and a
+// maximum, so it does not depend on the visiting order or the thread count. NaN over no particle.
+double continuous_extent(const World& world, const Probe& pr) {
+  const Particles& P = world.particles();
+  const std::vector<char> in_set = body_mask(world, pr.bodies);
+  const double link = pr.link > 0.0 ? pr.link : world.kernel().support;
+  std::vector<Vec3> x;
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (in_set[P.body[i]] && !is_buffer(P.kind[i]) && (!pr.region || pr.region->contains(P.x[i])))
+      x.push_back(P.x[i]);
+  if (x.empty()) return kNaN;
+  std::vector<uint32_t> parent(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) parent[i] = static_cast<uint32_t>(i);
+  auto root = [&](uint32_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];  // path halving
+    return i;
+  };
+  NeighborSearch nb;
+  nb.build(x, link);
+  for (std::size_t i = 0; i < x.size(); ++i)
+    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
+      const uint32_t a = root(static_cast<uint32_t>(i)), b = root(nb.index()[k]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  std::vector<std::size_t> count(x.size(), 0);
+  std::vector<double> top(x.size(), -std::numeric_limits<double>::infinity());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const uint32_t r = root(static_cast<uint32_t>(i));
+    ++count[r];
+    top[r] = std::max(top[r], x[i][pr.axis]);
+  }
+  std::size_t best_count = 0;
+  double best = kNaN;
+  for (std::size_t r = 0; r < x.size(); ++r)
+    if (count[r] > best_count || (count[r] == best_count && count[r] > 0 && top[r] > best)) {
+      best_count = count[r];
+      best = top[r];
+    }
+  // A particle stands for the cube of side dx around it: the fluid's edge is half a spacing beyond the last
+  // particle's centre (as where World sets the free surface of a fluid body at rest), so a column of side a
+  // measures a at t = 0, at any resolution.
+  return best + 0.5 * world.scene().spacing;
+}
+
 // Largest eigenvalue of the Green-Lagrange strain E = (F^T F - I) / 2 (paper eq. 15).
 double largest_principal_strain(const Eigen::Matrix3d& F) {
   const Eigen::Matrix3d E = 0.5 * (F.transpose() * F - Eigen::Matrix3d::Identity());
@@ -269,6 +319,10 @@ std::vector<double> ProbeSet::measure(const World& world) const {
     const Probe& pr = probes_[k];
     switch (pr.type) {
       case ProbeType::Extent: {
+        if (pr.stat_extent) {
+          out.push_back(continuous_extent(world, pr));
+          break;
+        }
         // Max (or min) coordinate over the bodies' particles inside the region: a water gauge or surge front.
         const std::vector<char> in_set = body_mask(world, pr.bodies);
         const double sign = pr.stat_max ? 1.0 : -1.0;
