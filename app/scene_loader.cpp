@@ -324,7 +324,8 @@ class Loader {
     return {"base",           "annulus_radius", "commissure_radius", "commissure_height", "sinus_radius",
             "stj_height",     "aorta_radius",   "lvot_length",       "aorta_length",      "leaflet_free_edge",
             "leaflet_height", "leaflet_layers", "wall_layers",       "commissure_angles", "sinuses",
-            "leaflet_shape",  "mirror_tilt"};
+            "leaflet_shape",  "mirror_tilt",    "graft_diameter",    "graft_shape",       "neo_sinus_bulge",
+            "stj_diameter",   "cusps"};
   }
 
   // Reads the aortic_root parameters that o holds over p; with fill, every parameter, defaults written into
@@ -357,6 +358,20 @@ class Loader {
       p.mirror_leaflets = o.choice("leaflet_shape", {"labrosse", "mirror"},
                                    p.mirror_leaflets ? "mirror" : "labrosse") == "mirror";
     if (o.has("mirror_tilt")) p.mirror_tilt = o.number("mirror_tilt");
+    surgical_params(o, p);
+  }
+
+  // The surgical keys (issue 19 item 1; sim/geometry/aortic_root.hpp): read only where given, no defaults
+  // written (a scene without them reads as before).
+  static void surgical_params(Obj& o, AorticRootParams& p) {
+    if (o.has("graft_diameter")) p.graft_diameter = o.positive("graft_diameter");
+    if (o.has("graft_shape"))
+      p.graft_shape = o.choice("graft_shape", {"straight", "neo_sinus"}) == "neo_sinus"
+                          ? AorticGraftShape::NeoSinus
+                          : AorticGraftShape::Straight;
+    if (o.has("neo_sinus_bulge")) p.neo_sinus_bulge = o.non_negative("neo_sinus_bulge");
+    if (o.has("stj_diameter")) p.stj_diameter = o.positive("stj_diameter");
+    if (o.has("cusps")) p.fixed_cusps = o.choice("cusps", {"root", "fixed"}) == "fixed";
   }
 
   Shape aortic_root_shape(json& j, const std::string& path, double dx) {
@@ -741,8 +756,9 @@ class Loader {
     if (sh.kind == ShapeKind::Box || sh.kind == ShapeKind::Container) {
       extent = sh.box.max - sh.box.min + Vec3::Constant(2 * sh.layers * dx);
     } else if (sh.kind == ShapeKind::AorticRoot) {
-      const AorticRootParams& a = sh.aortic;
-      const double r = std::max({a.annulus_radius, a.sinus_radius, a.aorta()}) + a.wall_layers * dx;
+      const AorticRootParams a = surgical_root(sh.aortic);
+      const double r =
+          std::max({a.annulus_radius, a.sinus_radius, a.stj_radius(), a.aorta()}) + a.wall_layers * dx;
       extent = Vec3(2 * r, a.lvot_length + a.stj() + a.aorta_length, 2 * r);
     } else
       extent = Vec3::Constant(2 * (sh.radius + sh.layers * dx) + sh.length);

@@ -72,6 +72,9 @@ enum class ShapeKind {
   CylindricalPanel
 };
 
+// Graft shapes of the aortic root's graft mode (AorticRootParams::graft_shape; Unset: not given).
+enum class AorticGraftShape { Unset, Straight, NeoSinus };
+
 // Parametric aortic root and valve (sim/geometry/aortic_root.hpp; docs/scenes.md). Lengths in metres, angles
 // in degrees. The root's axis is +y through `base` (the centre of the annulus disc); blood flows towards +y.
 // Defaults: Labrosse et al. 2006, J. Biomech. 39:2665 (annulus, commissures, leaflet free edge and height);
@@ -103,9 +106,23 @@ struct AorticRootParams {
   // by the scene loader on every part of the root, so the leaflets sample one layer on their mid-surface and
   // the blood keeps its gap from that layer (sim/geometry/aortic_root.hpp).
   bool shell_leaflets = false;
+  // Surgical geometry (issue 19 item 1; docs/scenes.md, sim/geometry/aortic_root.hpp surgical_root). Graft
+  // mode: graft_diameter > 0 makes the root a graft of that inner diameter (commissure and sinotubular-
+  // junction radius = graft_diameter / 2; the annulus keeps annulus_radius), straight or with neo-sinuses
+  // bulging neo_sinus_bulge out of it; 0: the native root.
+  double graft_diameter = 0.0;
+  AorticGraftShape graft_shape = AorticGraftShape::Unset;
+  double neo_sinus_bulge = 0.0;
+  // Native root: lumen diameter at the sinotubular junction; 0: 2 commissure_radius.
+  double stj_diameter = 0.0;
+  // Cusps "fixed": the patient's cusps (free edge leaflet_free_edge, geometric height leaflet_height) kept
+  // whatever the root; Labrosse leaflets always are, mirror leaflets get the mirror_tilt that keeps the free
+  // edge. "root" (false): mirror leaflets follow the root.
+  bool fixed_cusps = false;
 
   double stj() const { return stj_height > 0.0 ? stj_height : commissure_height; }
-  double aorta() const { return aorta_radius > 0.0 ? aorta_radius : commissure_radius; }
+  double stj_radius() const { return stj_diameter > 0.0 ? 0.5 * stj_diameter : commissure_radius; }
+  double aorta() const { return aorta_radius > 0.0 ? aorta_radius : stj_radius(); }
 };
 
 enum class AorticPart { Wall, Blood, Leaflet };

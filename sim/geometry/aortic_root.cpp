@@ -50,6 +50,8 @@ constexpr double kShellBloodGap = 0.5;    // ... from a shell leaflet's sheet (a
 constexpr double kShellPatch = 0.75;      // ... over a shell particle's patch (tangential offset, in dx)
 constexpr int kMeridianSamples = 100;     // arc-length table along a leaflet meridian
 constexpr int kAttachmentSamples = 512;   // mirror leaflets: attachment heights tabulated across a sector
+constexpr double kMaxTilt = 30.0;         // mirror_tilt within +-30 degrees
+constexpr int kCurveSamples = 400;        // free edge and mid-line lengths: chords along the curve
 
 // Projected distance of a point at polar angle offset a inside a sector of width w, radius r, to the
 // sector's two bounding half-planes (rays in projection).
@@ -60,7 +62,50 @@ double sector_distance(double r, double a, double w) {
 
 }  // namespace
 
-AorticRoot::AorticRoot(const AorticRootParams& p) : p_(p) {
+AorticRootParams surgical_root(const AorticRootParams& p) {
+  AorticRootParams q = p;
+  if (q.graft_diameter > 0.0) {
+    // The graft (David & Feindel 1992): commissures and STJ on its wall; the annulus (and the LVOT below)
+    // keep annulus_radius. The neo-sinus bulge is A itself: sinus_radius is the cone's radius at half the
+    // STJ height (where the bulge peaks mid-sinus) plus the bulge.
+    const double r = 0.5 * q.graft_diameter;
+    q.commissure_radius = r;
+    q.stj_diameter = 0.0;
+    q.sinuses = q.graft_shape == AorticGraftShape::NeoSinus;
+    const double y = 0.5 * q.stj();
+    const double cone =
+        y < q.commissure_height ? q.annulus_radius + (r - q.annulus_radius) * y / q.commissure_height : r;
+    if (q.sinuses) q.sinus_radius = cone + q.neo_sinus_bulge;
+  }
+  if (q.fixed_cusps && q.mirror_leaflets) {
+    // The tilt that makes the mirror leaflets' free edge leaflet_free_edge long: bisection on the sign of
+    // the difference over [0, kMaxTilt], outward into the sinus, where the free edge grows with the tilt
+    // (measured: 27.4 to 37.7 mm in the default root; it grows again for tilts below 0, towards leaflets
+    // that fold against the ventricle). An end when the length is out of reach: check_aortic_root refuses it.
+    q.fixed_cusps = false;
+    auto excess = [&](double tilt) {
+      AorticRootParams t = q;
+      t.mirror_tilt = tilt;
+      return AorticRoot(t).free_edge_length() - q.leaflet_free_edge;
+    };
+    double lo = 0.0, hi = kMaxTilt;
+    const double f_lo = excess(lo), f_hi = excess(hi);
+    if ((f_lo < 0.0) == (f_hi < 0.0)) {
+      q.mirror_tilt = std::abs(f_lo) < std::abs(f_hi) ? lo : hi;
+    } else {
+      const bool rising = f_lo < 0.0;
+      for (int it = 0; it < 40; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        ((excess(mid) < 0.0) == rising ? lo : hi) = mid;
+      }
+      q.mirror_tilt = 0.5 * (lo + hi);
+    }
+    // The result is a root with this tilt (cusps "root"): built again from it, nothing is solved again.
+  }
+  return q;
+}
+
+AorticRoot::AorticRoot(const AorticRootParams& p) : p_(surgical_root(p)) {
   for (int k = 0; k < 3; ++k) phi_[k] = deg(p_.commissure_angles[k]);
   dphi_[0] = phi_[1] - phi_[0];
   dphi_[1] = phi_[2] - phi_[1];
@@ -109,8 +154,14 @@ double AorticRoot::cone_radius(double y) const {
   const double ra = p_.annulus_radius, rc = p_.commissure_radius;
   if (y <= 0.0) return ra;
   if (y < p_.commissure_height) return ra + (rc - ra) * y / p_.commissure_height;
-  if (y <= p_.stj()) return rc;
-  return rc + (p_.aorta() - rc) * smoothstep((y - p_.stj()) / rc);
+  if (y <= p_.stj()) {
+    // stj_diameter: linear from the commissure radius to the STJ radius (check_aortic_root asks for an STJ
+    // above the commissures when the two differ).
+    if (p_.stj_diameter <= 0.0 || p_.stj() <= p_.commissure_height) return rc;
+    return rc + (p_.stj_radius() - rc) * (y - p_.commissure_height) / (p_.stj() - p_.commissure_height);
+  }
+  const double rs = p_.stj_radius();
+  return rs + (p_.aorta() - rs) * smoothstep((y - p_.stj()) / rc);
 }
 
 int AorticRoot::sector_of(double theta, double& s) const {
@@ -251,6 +302,35 @@ double AorticRoot::midline_length(double sag) const {
     y0 = y;
   }
   return len;
+}
+
+double AorticRoot::free_edge_length() const {
+  double len = 0.0;
+  for (int k = 0; k < 3; ++k)
+    for (double s : {0.0, 1.0}) {
+      Vec3 prev = leaflet_surface(k, 0.0, s);
+      for (int i = 1; i <= kCurveSamples; ++i) {
+        const Vec3 q = leaflet_surface(k, static_cast<double>(i) / kCurveSamples, s);
+        len += (q - prev).norm();
+        prev = q;
+      }
+    }
+  return len / 3.0;
+}
+
+double AorticRoot::geometric_height() const {
+  // As many chords as midline_length() takes (Labrosse's mid-line has rho^1.5 at the centre).
+  const int n = 2000;
+  double len = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    Vec3 prev = leaflet_surface(k, 0.0, 0.5);
+    for (int i = 1; i <= n; ++i) {
+      const Vec3 q = leaflet_surface(k, static_cast<double>(i) / n, 0.5);
+      len += (q - prev).norm();
+      prev = q;
+    }
+  }
+  return len / 3.0;
 }
 
 double AorticRoot::leaflet_lowest() const {
@@ -630,9 +710,9 @@ std::vector<Vec3> AorticRoot::blood_points(double dx) const {
   };
 
   const double y_bot = -p_.lvot_length, y_top = p_.stj() + p_.aorta_length;
-  const double r_max =
-      std::max({p_.annulus_radius, p_.commissure_radius, p_.aorta(), p_.sinuses ? p_.sinus_radius : 0.0}) +
-      dx;
+  const double r_max = std::max({p_.annulus_radius, p_.commissure_radius, p_.stj_radius(), p_.aorta(),
+                                 p_.sinuses ? p_.sinus_radius : 0.0}) +
+                       dx;
   const int nr = static_cast<int>(std::ceil(r_max / dx));
   const int ny = static_cast<int>(std::lround((y_top - y_bot) / dx));
   std::vector<Vec3> out;
@@ -655,7 +735,10 @@ std::vector<Vec3> AorticRoot::blood_points(double dx) const {
 
 // ---------------------------------------------------------------------------------------------------------
 
-std::optional<AorticRootError> check_aortic_root(const AorticRootParams& p, double dx) {
+namespace {
+
+// The checks on the parameters as built (surgical keys applied).
+std::optional<AorticRootError> check_resolved(const AorticRootParams& p, double dx) {
   auto err = [](std::string param, std::string msg) {
     return AorticRootError{std::move(param), std::move(msg)};
   };
@@ -684,7 +767,7 @@ std::optional<AorticRootError> check_aortic_root(const AorticRootParams& p, doub
 
   if (p.stj_height > 0 && p.stj_height < p.commissure_height)
     return err("stj_height", "must not lie below commissure_height (" + num(p.commissure_height) + ")");
-  if (p.sinuses) {
+  if (p.sinuses && !(p.graft_diameter > 0.0)) {  // a neo-sinus graft's bulge is checked as such
     if (p.commissure_radius >= p.sinus_radius)
       return err("commissure_radius", "must be smaller than sinus_radius (" + num(p.sinus_radius) + ")");
     if (p.annulus_radius >= p.sinus_radius)
@@ -733,6 +816,63 @@ std::optional<AorticRootError> check_aortic_root(const AorticRootParams& p, doub
   if (p.lvot_length < dx || p.aorta_length < dx)
     return err(p.lvot_length < dx ? "lvot_length" : "aorta_length", "must be at least one particle spacing");
   return std::nullopt;
+}
+
+// The surgical keys themselves (on the parameters as given).
+std::optional<AorticRootError> check_surgical(const AorticRootParams& p) {
+  auto err = [](std::string param, std::string msg) {
+    return AorticRootError{std::move(param), std::move(msg)};
+  };
+  const bool graft = p.graft_diameter > 0.0;
+  if (!(p.graft_diameter >= 0.0) || !std::isfinite(p.graft_diameter))
+    return err("graft_diameter", "must be positive");
+  if (!(p.neo_sinus_bulge >= 0.0) || !std::isfinite(p.neo_sinus_bulge))
+    return err("neo_sinus_bulge", "must be positive");
+  if (!(p.stj_diameter >= 0.0) || !std::isfinite(p.stj_diameter))
+    return err("stj_diameter", "must be positive");
+  if (!graft && p.graft_shape != AorticGraftShape::Unset)
+    return err("graft_shape", "needs graft_diameter (a native root's sinuses are sinuses and sinus_radius)");
+  const bool neo = p.graft_shape == AorticGraftShape::NeoSinus;
+  if (p.neo_sinus_bulge > 0.0 && !neo)
+    return err("neo_sinus_bulge", "only a graft with graft_shape \"neo_sinus\" has a bulge");
+  if (neo && !(p.neo_sinus_bulge > 0.0))
+    return err("neo_sinus_bulge",
+               "missing or 0: a neo_sinus graft needs its bulge out of the graft (metres, > 0)");
+  if (neo && p.neo_sinus_bulge > 0.5 * p.graft_diameter)
+    return err("neo_sinus_bulge", num(p.neo_sinus_bulge) + " is larger than the graft radius (" +
+                                      num(0.5 * p.graft_diameter) + ")");
+  if (graft && p.stj_diameter > 0.0)
+    return err("stj_diameter", "the sinotubular junction follows the graft (graft_diameter): leave it out");
+  if (p.stj_diameter > 0.0 && p.stj_diameter != 2.0 * p.commissure_radius && p.stj() <= p.commissure_height)
+    return err("stj_diameter", num(p.stj_diameter) + " differs from 2 x commissure_radius (" +
+                                   num(2.0 * p.commissure_radius) +
+                                   "): needs stj_height above commissure_height, for the wall to widen or "
+                                   "narrow from the commissures to the junction");
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<AorticRootError> check_aortic_root(const AorticRootParams& p, double dx) {
+  if (auto e = check_surgical(p)) return e;
+  const AorticRootParams q = surgical_root(p);
+  auto e = check_resolved(q, dx);
+  if (e && p.graft_diameter > 0.0) {
+    // In a graft the radii are the graft's: name the key that set them.
+    if (e->param == "commissure_radius") e->param = "graft_diameter";
+    e->message += " (graft_diameter " + num(p.graft_diameter) + ": commissure_radius = graft_diameter / 2)";
+  }
+  if (!e && p.fixed_cusps && p.mirror_leaflets) {
+    const AorticRoot root(q);
+    const double fe = root.free_edge_length();
+    if (std::abs(fe - p.leaflet_free_edge) > 1e-6 * p.leaflet_free_edge)
+      return AorticRootError{"leaflet_free_edge",
+                             num(p.leaflet_free_edge) +
+                                 " cannot be kept by mirror leaflets in this root (cusps \"fixed\"): "
+                                 "the nearest, at mirror_tilt " +
+                                 num(root.params().mirror_tilt) + ", is " + num(fe)};
+  }
+  return e;
 }
 
 ShapeSample sample_aortic_root(const AorticRootParams& p, AorticPart part, int leaflet, double dx) {

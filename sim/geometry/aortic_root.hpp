@@ -61,6 +61,22 @@
 //  * Blood: lattice points (spacing dx, aligned with base) at least dx/2 inside the lumen surface (along its
 //    normal) and 0.9 dx from every leaflet particle, from the bottom of the LVOT to the top of the aorta.
 //
+//  * Surgical geometry (issue 19 item 1, valve-sparing root replacement by reimplantation, David & Feindel
+//    1992, J. Thorac. Cardiovasc. Surg. 103:617-622: the root is replaced by a tube graft sewn below the
+//    annulus, the commissures resuspended inside it, the patient's cusps kept). surgical_root() rewrites the
+//    parameters before anything is built: with graft_diameter > 0 the commissure and STJ radius are
+//    graft_diameter / 2 (the aorta too unless aorta_radius is set; the annulus and the LVOT keep
+//    annulus_radius, the cone runs from it to the graft's radius: set annulus_radius to the graft's radius
+//    for a cylinder); a straight graft has no sinuses, a neo_sinus graft the sinus bulge above with
+//    A = neo_sinus_bulge (sinus_radius = cone radius at half the STJ height + bulge). stj_diameter (native
+//    roots) widens or narrows the wall linearly from the commissure radius at commissure_height to
+//    stj_diameter / 2 at stj_height; the aorta then starts from it. Commissure height and position are the
+//    existing commissure_height and commissure_angles (one commissure rotated by delta: sinus arcs 120 +
+//    delta, 120 - delta, 120). Fixed cusps: Labrosse leaflets are built from leaflet_free_edge and
+//    leaflet_height in any root; mirror leaflets have one free parameter, mirror_tilt, which is solved
+//    (bisection on [0, 30] degrees, outward) so that the free edge is leaflet_free_edge long; their geometric
+//    height then follows the root (geometric_height() says how far).
+//
 // All parts of one root must share the body transforms (rotate, translate); they rotate about `base`.
 //
 // Defaults (sim/scene.hpp AorticRootParams): Labrosse, Beller, Robicsek & Thubrikar 2006, "Geometric modeling
@@ -89,6 +105,11 @@ struct AorticRootError {
 };
 std::optional<AorticRootError> check_aortic_root(const AorticRootParams& p, double dx);
 
+// The parameters with the surgical keys applied (see the header comment): a native root's come back as they
+// are. AorticRoot applies it to the parameters it is given (params() returns the result; with fixed mirror
+// cusps that is a root with the solved mirror_tilt and fixed_cusps false, so it is not solved again).
+AorticRootParams surgical_root(const AorticRootParams& p);
+
 // The particles (and for the wall, the lumen surface mesh) of one part, in world coordinates before the
 // body's own rotate/translate. Leaflets carry `clamped` flags. Deterministic order.
 ShapeSample sample_aortic_root(const AorticRootParams& p, AorticPart part, int leaflet, double dx);
@@ -115,6 +136,10 @@ class AorticRoot {
   double attachment_height(int k, double s) const;
   double coaptation_height() const { return y_c_; }  // centre of the closed valve, above the annulus
   double belly_sag() const { return sag_; }
+  // The closed leaflets' free edge (commissure -> centre -> next commissure) and geometric height (the
+  // mid-line, annulus nadir -> centre), on the surface without the dx/2 inset, averaged over the three.
+  double free_edge_length() const;
+  double geometric_height() const;
   // Closed leaflet surface point (root frame, relative to base) at (rho, s) of leaflet k; with inset > 0, the
   // surface pulled in by that distance from the two coaptation planes (see the header comment).
   Vec3 leaflet_surface(int k, double rho, double s, double inset = 0.0) const;
