@@ -195,7 +195,7 @@ std::vector<Polar> inner_wall(const AorticRoot& root, double dx) {
 }  // namespace
 
 TEST_CASE("aortic graft: without the surgical keys the root is the one built before them",
-          "[aortic][graft]") {
+          "[aortic][graft][long]") {
   // Hashes of every part's particles, clamps, normals, areas and wall mesh, recorded on main at b1968f0
   // (before the surgical keys) with the [.aortic-hash] case below: the default Labrosse root, the scenes'
   // mirror root (tilt 6.5), the same with shell leaflets, and a root without sinuses with unequal
@@ -330,7 +330,7 @@ TEST_CASE("aortic graft: a rotated commissure sits at the asked angle, sinus arc
   }
 }
 
-TEST_CASE("aortic graft: the patient's cusps stay as the graft diameter changes", "[aortic][graft]") {
+TEST_CASE("aortic graft: the patient's cusps stay as the graft diameter changes", "[aortic][graft][long]") {
   // Labrosse leaflets (built from leaflet_free_edge and leaflet_height) and mirror leaflets with cusps
   // "fixed" (mirror_tilt solved for the free edge), in straight grafts of 26 and 30 mm.
   for (bool mirror : {false, true}) {
