@@ -504,7 +504,10 @@ TEST_CASE("shell validation: a cantilever strip under an end moment 2 pi E I / L
   // L = 12, b = 1, t = 0.5, E = 1.2e6, nu = 0 (Sze et al. 2004's roll-up, thicker so that it runs faster: the
   // closed circle is independent of t). The moment, on the directors of the last row, ramps up over six first
   // periods and is held for two; damping 2 omega_1.
-  const double L = 12, b = 1, t = 0.5, dx = 0.25, E = 1.2e6, rho = 1000.0;
+  const double L = 12, b = 1, E = 1.2e6, rho = 1000.0;
+  // Diagnostics (docs/validation.md): ROLL_T, ROLL_DX change the thickness and the spacing.
+  const double t = std::getenv("ROLL_T") ? std::atof(std::getenv("ROLL_T")) : 0.5;
+  const double dx = std::getenv("ROLL_DX") ? std::atof(std::getenv("ROLL_DX")) : 0.25;
   Scene s = strip_scene(L, b, t, dx, E, rho);
   const double EI = E * b * t * t * t / 12, M = 2 * std::numbers::pi * EI / L;
   const double f1 = 1.8751 * 1.8751 / (2 * std::numbers::pi * L * L) * std::sqrt(E * t * t / (12 * rho));
@@ -536,6 +539,13 @@ TEST_CASE("shell validation: a cantilever strip under an end moment 2 pi E I / L
     };
     apply();
     w.advance_to(time, [&] {
+      // Diagnostic (docs/validation.md): ROLL_PLANAR=1 keeps the directors in the bending plane (d_y = 0).
+      if (std::getenv("ROLL_PLANAR"))
+        for (std::size_t k = 0; k < sh.size(); ++k) {
+          Vec3 d = sh.director(k);
+          d.y() = 0;
+          sh.set_director(k, d);
+        }
       apply();
       return true;
     });
@@ -572,6 +582,7 @@ TEST_CASE("shell validation: Scordelis-Lo roof, mid free-edge vertical displacem
   s.cfl = 0.5;
   Material m = shell_material(4.32e8, 0.0, 0.25, 36.0);
   m.shell_damping = std::getenv("ROOF_DAMPING") ? std::atof(std::getenv("ROOF_DAMPING")) : 12.0;
+  if (std::getenv("ROOF_HG")) m.hourglass = std::atof(std::getenv("ROOF_HG"));  // diagnostic
   s.materials = {m};
   Body b;
   b.name = "roof";
