@@ -1,12 +1,14 @@
 // One-layer shells (sim/solid/shell.hpp): patch tests (uniform stretch, rigid rotation, constant curvature,
 // momentum), the clamped circular plate under pressure, a cantilever strip's frequency and energy, bad input,
 // determinism.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <numbers>
 #include <random>
+#include <sstream>
 
 #include "builders.hpp"
 #include "cli_helpers.hpp"
@@ -611,6 +613,25 @@ TEST_CASE("shell validation: Scordelis-Lo roof, mid free-edge vertical displacem
     prev = uz;
   }
   const double uz = w.particles().x[probe].z() - w.particles().x0[probe].z();
+  {  // The mid-span section's profile uz(angle) and its linear extrapolation from the two outer rows to 40
+     // deg.
+    const Particles& P = w.particles();
+    std::vector<std::pair<double, double>> prof;
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (std::abs(P.x0[i].x()) < 1e-6 && P.x0[i].y() > 0)
+        prof.emplace_back(std::atan2(P.x0[i].y(), P.x0[i].z() + R) * 180 / std::numbers::pi,
+                          P.x[i].z() - P.x0[i].z());
+    std::sort(prof.begin(), prof.end());
+    std::ostringstream os;
+    for (const auto& [a, u] : prof) os << a << ":" << u << " ";
+    if (prof.size() >= 2) {
+      const auto& p1 = prof[prof.size() - 2];
+      const auto& p2 = prof.back();
+      os << "; extrapolated to 40 deg: "
+         << p2.second + (40 - p2.first) * (p2.second - p1.second) / (p2.first - p1.first);
+    }
+    WARN("Scordelis-Lo mid-span profile (deg:uz) " << os.str());
+  }
   WARN("Scordelis-Lo: mid free-edge uz = " << uz << " at " << w.particles().x0[probe].transpose()
                                            << ", reference -0.3024, ratio " << -uz / 0.3024 << ", "
                                            << sh.size() << " particles");
