@@ -1,12 +1,14 @@
 // One-layer shells (sim/solid/shell.hpp): patch tests (uniform stretch, rigid rotation, constant curvature,
 // momentum), the clamped circular plate under pressure, a cantilever strip's frequency and energy, bad input,
 // determinism.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <numbers>
 #include <random>
+#include <sstream>
 
 #include "builders.hpp"
 #include "cli_helpers.hpp"
@@ -504,7 +506,10 @@ TEST_CASE("shell validation: a cantilever strip under an end moment 2 pi E I / L
   // L = 12, b = 1, t = 0.5, E = 1.2e6, nu = 0 (Sze et al. 2004's roll-up, thicker so that it runs faster: the
   // closed circle is independent of t). The moment, on the directors of the last row, ramps up over six first
   // periods and is held for two; damping 2 omega_1.
-  const double L = 12, b = 1, t = 0.5, dx = 0.25, E = 1.2e6, rho = 1000.0;
+  const double L = 12, b = 1, E = 1.2e6, rho = 1000.0;
+  // Diagnostics (docs/validation.md): ROLL_T, ROLL_DX change the thickness and the spacing.
+  const double t = std::getenv("ROLL_T") ? std::atof(std::getenv("ROLL_T")) : 0.5;
+  const double dx = std::getenv("ROLL_DX") ? std::atof(std::getenv("ROLL_DX")) : 0.25;
   Scene s = strip_scene(L, b, t, dx, E, rho);
   const double EI = E * b * t * t * t / 12, M = 2 * std::numbers::pi * EI / L;
   const double f1 = 1.8751 * 1.8751 / (2 * std::numbers::pi * L * L) * std::sqrt(E * t * t / (12 * rho));
@@ -536,6 +541,13 @@ TEST_CASE("shell validation: a cantilever strip under an end moment 2 pi E I / L
     };
     apply();
     w.advance_to(time, [&] {
+      // Diagnostic (docs/validation.md): ROLL_PLANAR=1 keeps the directors in the bending plane (d_y = 0).
+      if (std::getenv("ROLL_PLANAR"))
+        for (std::size_t k = 0; k < sh.size(); ++k) {
+          Vec3 d = sh.director(k);
+          d.y() = 0;
+          sh.set_director(k, d);
+        }
       apply();
       return true;
     });
@@ -572,6 +584,7 @@ TEST_CASE("shell validation: Scordelis-Lo roof, mid free-edge vertical displacem
   s.cfl = 0.5;
   Material m = shell_material(4.32e8, 0.0, 0.25, 36.0);
   m.shell_damping = std::getenv("ROOF_DAMPING") ? std::atof(std::getenv("ROOF_DAMPING")) : 12.0;
+  if (std::getenv("ROOF_HG")) m.hourglass = std::atof(std::getenv("ROOF_HG"));  // diagnostic
   s.materials = {m};
   Body b;
   b.name = "roof";
@@ -600,6 +613,25 @@ TEST_CASE("shell validation: Scordelis-Lo roof, mid free-edge vertical displacem
     prev = uz;
   }
   const double uz = w.particles().x[probe].z() - w.particles().x0[probe].z();
+  {  // The mid-span section's profile uz(angle) and its linear extrapolation from the two outer rows to 40
+     // deg.
+    const Particles& P = w.particles();
+    std::vector<std::pair<double, double>> prof;
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (std::abs(P.x0[i].x()) < 1e-6 && P.x0[i].y() > 0)
+        prof.emplace_back(std::atan2(P.x0[i].y(), P.x0[i].z() + R) * 180 / std::numbers::pi,
+                          P.x[i].z() - P.x0[i].z());
+    std::sort(prof.begin(), prof.end());
+    std::ostringstream os;
+    for (const auto& [a, u] : prof) os << a << ":" << u << " ";
+    if (prof.size() >= 2) {
+      const auto& p1 = prof[prof.size() - 2];
+      const auto& p2 = prof.back();
+      os << "; extrapolated to 40 deg: "
+         << p2.second + (40 - p2.first) * (p2.second - p1.second) / (p2.first - p1.first);
+    }
+    WARN("Scordelis-Lo mid-span profile (deg:uz) " << os.str());
+  }
   WARN("Scordelis-Lo: mid free-edge uz = " << uz << " at " << w.particles().x0[probe].transpose()
                                            << ", reference -0.3024, ratio " << -uz / 0.3024 << ", "
                                            << sh.size() << " particles");

@@ -25,7 +25,9 @@
 //     under translation and rotation) and, undamped, energy;
 //   - hourglass control is an energy too (as in sim/solid/solid_tlsph.cpp): U_hg = sum over pairs
 //     1/2 k_ij |eps_ij|^2 with eps_ij = (F_i + F_j) X_ij / 2 - x_ij, zero for every affine motion and third
-//     order for smooth ones, against the zig-zag modes that nodal integration cannot see;
+//     order for smooth ones, against the zig-zag modes that nodal integration cannot see; the part of eps
+//     along the pair's mean director is weighted by beta = min(1, 3 t^2 / |X_ij|^2), the bending scale (at
+//     the membrane's it locks thin sheets in bending; Shells::update, docs/validation.md "Shells");
 //   - rotary inertia rho t^3 / 12 per area; mass rho t per area.
 // Neighbours are the reference neighbours of one body (found once); shells do not see the fluid yet.
 #pragma once
