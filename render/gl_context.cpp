@@ -1,15 +1,16 @@
 #include "gl_context.hpp"
 
-#include <GL/osmesa.h>  // also brings gl.h and glext.h (GL_GLEXT_PROTOTYPES)
-
 #include <algorithm>
 #include <cctype>
 #include <sstream>
 #include <vector>
 
+#include "gl_api.hpp"  // GL and OSMesa, loaded at the first GlContext (not linked)
+
 namespace aortasph {
 
 GlContext::GlContext() {
+  gl::load();  // opens libOSMesa on the first context: a run that draws nothing never maps llvmpipe
   const int attribs[] = {OSMESA_FORMAT,
                          OSMESA_RGBA,
                          OSMESA_DEPTH_BITS,

@@ -1,6 +1,6 @@
 #include "renderer.hpp"
 
-#include <GL/osmesa.h>  // also brings gl.h and glext.h (GL_GLEXT_PROTOTYPES)
+#include "gl_api.hpp"  // GL and OSMesa, loaded at the first GlContext (not linked)
 
 #include <algorithm>
 #include <cmath>

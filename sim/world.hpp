@@ -247,7 +247,13 @@ class World {
   bool lists_valid_ = false;
   long builds_ = 0;
   int sort_every_builds_ = 4;
+  // Positions at the last build of the particles that can move (every kind but the fixed walls, whose
+  // position never changes): x_at_build_[k] is that of particle skin_index_[k]. The checkpoint holds the
+  // full array (walls at their position), as before.
   std::vector<Vec3> x_at_build_;
+  std::vector<uint32_t> skin_index_;
+  void record_build_positions(const std::vector<Vec3>& x);
+  std::vector<Vec3> build_positions() const;  // every particle's, walls included
 };
 
 }  // namespace aortasph

@@ -814,3 +814,37 @@ TEST_CASE("render: a run with per-camera overrides, the camera without them rend
     CHECK_FALSE(cameras[0].contains(key));
   CHECK(cameras[2]["hide"] == nlohmann::json::array({"right"}));
 }
+
+TEST_CASE("render: libOSMesa (llvmpipe, libLLVM) is loaded only by a run that draws frames", "[render]") {
+  // The renderer opens libOSMesa at its first GL context (render/gl_api.hpp), so that a run without frames
+  // does not carry llvmpipe's memory. The dynamic loader's own log (LD_DEBUG=files, glibc) names every
+  // library it maps; the rendering run guards that the log is seen at all.
+  const ScratchDir scratch("lazy_osmesa");
+  const fs::path scene = scratch.path / "tiny.json";
+  std::ofstream(scene) << R"({
+  "name": "tiny",
+  "domain": { "min": [-1, -1, -1], "max": [1, 1, 1] },
+  "resolution": { "spacing": 0.01, "smoothing_ratio": 1.3 },
+  "time": { "end": 0.002, "output_interval": 0.001, "cfl": 0.25, "max_dt": 1e-3 },
+  "gravity": [0, 0, 0],
+  "materials": { "water": { "type": "fluid", "density": 1000, "viscosity": 1e-6, "sound_speed": 20 } },
+  "bodies": [ { "name": "cube", "material": "water", "shape": { "box": { "min": [0, 0, 0], "max": [0.03, 0.03, 0.03] } } } ],
+  "render": { "width": 32, "height": 32,
+              "cameras": [ { "name": "c", "eye": [0.1, 0.1, 0.2], "target": [0.015, 0.015, 0.015], "up": [0, 1, 0] } ] }
+})";
+  const auto loader_log = [&](const std::string& name, const std::string& extra) {
+    const fs::path log = scratch.path / (name + ".log");
+    const std::string cmd = "LD_DEBUG=files " + std::string(AORTASPH_BINARY) + " run " + scene.string() +
+                            " --quiet --out " + (scratch.path / name).string() + extra + " > " +
+                            log.string() + " 2>&1";
+    REQUIRE(std::system(cmd.c_str()) == 0);
+    std::ifstream f(log);
+    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+  };
+  const std::string drawn = loader_log("drawn", "");
+  CHECK(fs::exists(scratch.path / "drawn" / "frames" / "c" / "frame_00002.png"));
+  CHECK(drawn.find("libOSMesa") != std::string::npos);
+  const std::string plain = loader_log("plain", " --no-render");
+  CHECK(plain.find("file=") != std::string::npos);  // the loader's log is there
+  CHECK(plain.find("libOSMesa") == std::string::npos);
+}

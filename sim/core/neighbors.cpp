@@ -193,12 +193,16 @@ void NeighborSearch::build(const std::vector<Vec3>& x, double radius, const std:
     });
   };
 
-  // Fixed, contiguous chunks of particles (their number does not depend on the thread count), each listed
-  // into its own buffer and appended to index_ in chunk order. The chunks are taken in waves of a few dozen
-  // so that only one wave's buffers exist beside index_ (the lists are never held twice); a wave's chunks
-  // are balanced dynamically over the threads.
-  const std::size_t chunks = std::clamp<std::size_t>(n / 512, 1, 1024);
-  const std::size_t wave = std::min<std::size_t>(chunks, 32);
+  // Contiguous chunks of particles, each listed into its own buffer and appended to index_ in chunk order, so
+  // the lists are the same whatever the chunks and waves (rows in particle order). The chunks are taken in
+  // waves of 8 per thread so that only one wave's buffers exist beside index_ (the lists are never held
+  // twice); a wave's chunks are balanced dynamically over the threads. Chunks of 256 particles in waves of 8
+  // per thread hold at most a quarter of what chunks of 512 in waves of 32 did on 2 threads (a fluid
+  // particle lists about 100 pairs: 3 MiB against up to 13 MiB with the buffers' growth,
+  // docs/performance.md).
+  const std::size_t chunks = std::clamp<std::size_t>(n / 256, 1, 4096);
+  const std::size_t wave =
+      std::min<std::size_t>(chunks, 8 * static_cast<std::size_t>(std::max(max_threads(), 1)));
   // index_ keeps its capacity between builds. Before the first one it is sized from the candidates the
   // stencils hold: a ball of the radius fills 4/3 pi / 2.5^3 = 26.8 % of the 5^3 cells of edge radius / 2
   // around it, so 28 % of the candidates (a fixed particle's: the moving ones only) is a slight overestimate
