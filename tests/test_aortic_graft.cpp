@@ -206,7 +206,7 @@ TEST_CASE("aortic graft: without the surgical keys the root is the one built bef
   CHECK(root_hash(hash_roots()[3], kDx) == kHashes[3]);
 }
 
-TEST_CASE("aortic graft: the commissures and the STJ sit on the graft; a straight graft has no sinus",
+TEST_CASE("aortic graft: the commissures and the STJ sit on the graft, a straight graft has no sinus",
           "[aortic][graft]") {
   for (double d : {0.024, 0.028, 0.032})
     for (bool cylinder : {false, true}) {

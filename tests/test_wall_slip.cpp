@@ -58,7 +58,7 @@ ChannelProfile profile(const World& w) {
 
 }  // namespace
 
-TEST_CASE("free-slip plates: a force-driven channel moves as a plug; no-slip plates give a curved profile",
+TEST_CASE("free-slip plates: a force-driven channel moves as a plug, no-slip plates give a curved profile",
           "[wall-slip][fluid]") {
   const double F = 8e-3, t = 0.2;  // 0.2 s: twice the slowest viscous time L^2 / (pi^2 nu)
   const double plug = F * t;       // the free fluid's velocity: 1.6 mm/s
@@ -85,7 +85,7 @@ TEST_CASE("free-slip plates: a force-driven channel moves as a plug; no-slip pla
   CHECK(ns.centre / ns.wall > 2.0);
 }
 
-TEST_CASE("the loader reads a body's slip condition; no slip by default", "[wall-slip][scene]") {
+TEST_CASE("the loader reads a body's slip condition, no slip by default", "[wall-slip][scene]") {
   const auto j = nlohmann::json::parse(R"({
     "name": "t",
     "domain": { "min": [-1, -1, -1], "max": [1, 1, 1] },
