@@ -293,7 +293,7 @@ TEST_CASE("aortic root: mirror leaflets are the open leaflet reflected across a 
   CHECK(belly.y() < 0.3 * p.commissure_height);
 }
 
-TEST_CASE("aortic root: tilted mirror leaflets with unequal commissures close the valve", "[aortic]") {
+TEST_CASE("aortic root: tilted mirror leaflets with unequal commissures close the valve", "[aortic][heavy]") {
   // Each leaflet has its own attachment plane, so with unequal sectors the free edges reach the coaptation
   // planes at different heights; the valve must still close, and neighbours meet about dx apart.
   const double dx = 0.001;
@@ -673,7 +673,7 @@ TEST_CASE("aortic root in flow: identical state and probes for 1 and 2 threads",
 }
 
 TEST_CASE("aortic root probes: orifice_area of the closed valve, leaflet stress, bad probe input",
-          "[aortic][scene]") {
+          "[aortic][scene][heavy]") {
   const std::string file = std::string(AORTASPH_TEST_DIR) + "/../scenes/aortic_root.json";
   const Scene s = load_scene(file, {}).scene;
   World w(s);

@@ -129,7 +129,7 @@ TEST_CASE("cli: bad input exits 2 with a message naming the problem", "[cli][bad
   CHECK(r.err.find("no_such_scene.json") != std::string::npos);
 }
 
-TEST_CASE("cli: probes.csv is bitwise identical for --threads 1 and 2", "[cli][determinism]") {
+TEST_CASE("cli: probes.csv is bitwise identical for --threads 1 and 2", "[cli][determinism][heavy]") {
   const fs::path dir = scratch("threads");
   std::string csv[2];
   for (int t = 1; t <= 2; ++t) {

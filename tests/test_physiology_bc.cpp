@@ -683,7 +683,7 @@ int wait_for(pid_t pid) {
 
 TEST_CASE(
     "pressure inlet from a waveform file and Windkessel outlet: SIGINT and resume give identical probes",
-    "[physiology][checkpoint][cli]") {
+    "[physiology][checkpoint][cli][heavy]") {
   // The waveform file is found relative to the scene file's folder, on resume too; the run is interrupted
   // between outputs, so the flows' averaging interval and the Windkessel state travel in the checkpoint.
   const fs::path dir = aortasph::test::scratch("physiology_resume");

@@ -221,7 +221,7 @@ TEST_CASE("off-axis collision of two boxes: momentum, angular momentum, energy, 
   CHECK(w.rigid_bodies()[1].velocity().x() - w.rigid_bodies()[0].velocity().x() > 0.0);
 }
 
-TEST_CASE("rigid bodies in fluid: bitwise identical for 1 and 2 threads", "[rigid][determinism]") {
+TEST_CASE("rigid bodies in fluid: bitwise identical for 1 and 2 threads", "[rigid][determinism][heavy]") {
   const double dx = 0.01;
   Scene s = fluid_cubes(dx);
   s.materials.push_back(steel(3000));

@@ -175,7 +175,7 @@ Scene sliding_scene() {
 }  // namespace
 
 TEST_CASE("shell contact: a sheet driven obliquely over another does not pass through between particles",
-          "[shell_contact]") {
+          "[shell_contact][heavy]") {
   World w(sliding_scene());
   const Particles& P = w.particles();
   double zmin = 1.0;

@@ -64,7 +64,7 @@ double attachment_length(const AorticRoot& root, int k, int n = 2000) {
 }  // namespace
 
 TEST_CASE("shell leaflets: one layer on the mid-surface, normals, areas and clamped attachment rows",
-          "[shell_leaflet]") {
+          "[shell_leaflet][heavy]") {
   for (const bool mirrored : {false, true}) {
     const AorticRootParams p = mirrored ? mirror() : labrosse();
     const AorticRoot root(p);

@@ -581,7 +581,7 @@ TEST_CASE("TL-SPH scratch: Rayleigh quotient of the EB mode", "[.scratch]") {
 }
 
 TEST_CASE("TL-SPH in fluid: the fluid's background pressure does not squeeze a soft solid",
-          "[solid][fluid]") {
+          "[solid][fluid][heavy]") {
   // A soft elastic slab on the floor of a closed box, still water above it, no gravity, a background
   // pressure of 2 kPa. Without gravity the water's pressure is the background alone, which is no load on
   // the body (a device of the fluid's discretisation): the slab must stay uncompressed. Had the reaction
