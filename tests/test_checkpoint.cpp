@@ -87,7 +87,8 @@ TEST_CASE("checkpoint: a loaded World continues bitwise as the saved one", "[che
   CHECK(state_of(b) == state_of(a));
 }
 
-TEST_CASE("checkpoint: an elastic body (its slot map and stress) continues bitwise", "[checkpoint][solid][heavy]") {
+TEST_CASE("checkpoint: an elastic body (its slot map and stress) continues bitwise",
+          "[checkpoint][solid][heavy]") {
   // The cubes collide while a clamped elastic plate below them swings: the spatial sort permutes the
   // elastic particles, so the solid's particle map must follow the stored order on load.
   Scene s = fluid_cubes(0.01);
