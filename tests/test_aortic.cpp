@@ -23,6 +23,7 @@
 #include "world.hpp"
 
 using namespace aortasph;
+using aortasph::test::min_distance;
 using aortasph::test::state_hash;
 using json = nlohmann::json;
 
@@ -159,29 +160,6 @@ Measured measure(const AorticRootParams& p, const Parts& parts, double dx) {
   m.orifice_fraction =
       orifice_area(valve, dx, p.base, Vec3::UnitY(), root.orifice_radius()) / root.annulus_area();
   return m;
-}
-
-// Smallest distance between a point of a and a point of b (hash grid of cell `reach`); reach if none closer.
-double min_distance(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double reach) {
-  std::map<std::tuple<int, int, int>, std::vector<Vec3>> grid;
-  auto key = [&](const Vec3& q) {
-    return std::tuple{static_cast<int>(std::floor(q.x() / reach)),
-                      static_cast<int>(std::floor(q.y() / reach)),
-                      static_cast<int>(std::floor(q.z() / reach))};
-  };
-  for (const Vec3& q : b) grid[key(q)].push_back(q);
-  double best = reach;
-  for (const Vec3& q : a) {
-    const auto [i, j, k] = key(q);
-    for (int di = -1; di <= 1; ++di)
-      for (int dj = -1; dj <= 1; ++dj)
-        for (int dk = -1; dk <= 1; ++dk) {
-          const auto it = grid.find({i + di, j + dj, k + dk});
-          if (it == grid.end()) continue;
-          for (const Vec3& o : it->second) best = std::min(best, (o - q).norm());
-        }
-  }
-  return best;
 }
 
 void check_dimensions(const AorticRootParams& p, double dx) {

@@ -14,11 +14,13 @@
 #include <numbers>
 #include <tuple>
 
+#include "builders.hpp"
 #include "errors.hpp"
 #include "geometry/aortic_root.hpp"
 #include "scene_loader.hpp"
 
 using namespace aortasph;
+using aortasph::test::min_distance;
 using json = nlohmann::json;
 
 namespace {
@@ -146,29 +148,6 @@ Cusps measure_cusps(const AorticRoot& root, const std::vector<Vec3> (&leaflets)[
     gh += binned_length(mid, p.annulus_radius, 0.0, dx) / 3;
   }
   return {fe, gh};
-}
-
-// Smallest distance between a point of a and one of b (brute force over a hash grid of cell `reach`).
-double min_distance(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double reach) {
-  std::map<std::tuple<int, int, int>, std::vector<Vec3>> grid;
-  auto key = [&](const Vec3& q) {
-    return std::tuple{static_cast<int>(std::floor(q.x() / reach)),
-                      static_cast<int>(std::floor(q.y() / reach)),
-                      static_cast<int>(std::floor(q.z() / reach))};
-  };
-  for (const Vec3& q : b) grid[key(q)].push_back(q);
-  double best = reach;
-  for (const Vec3& q : a) {
-    const auto [i, j, k] = key(q);
-    for (int di = -1; di <= 1; ++di)
-      for (int dj = -1; dj <= 1; ++dj)
-        for (int dk = -1; dk <= 1; ++dk) {
-          const auto it = grid.find({i + di, j + dj, k + dk});
-          if (it == grid.end()) continue;
-          for (const Vec3& o : it->second) best = std::min(best, (o - q).norm());
-        }
-  }
-  return best;
 }
 
 AorticRootParams graft(double diameter, AorticGraftShape shape, double bulge = 0.0) {
