@@ -52,6 +52,7 @@ struct Parameter {
   // has one path and its value is the value itself.
   std::vector<std::string> paths, labels;
   bool zipped = false;
+  json base;  // the base scene's own value at the first path (null when it has none): the report's reference
 };
 
 // The --set items of one value of a parameter.
@@ -177,6 +178,7 @@ Parameter zipped_parameter(const Study& s, const json& p, const std::string& whe
     par.values.push_back(v);
     par.where.push_back(at);
   }
+  if (const json* current = at_path(base.resolved, par.paths[0])) par.base = *current;
   for (std::size_t k = 0; k < par.paths.size(); ++k)
     if (!at_path(base.resolved, par.paths[k])) {
       std::vector<std::string> sets = s.fixed;
@@ -252,6 +254,7 @@ Study read_study(const fs::path& file) {
     par.path = p["path"].get<std::string>();
     par.label = p.value("label", par.path);
     const json* current = at_path(base.resolved, par.path);
+    if (current) par.base = *current;
     const int kinds = int(p.contains("values")) + int(p.contains("range")) + int(p.contains("scale"));
     if (kinds != 1) fail(s, where, "expected exactly one of values, range, scale");
     if (p.contains("values")) {
@@ -306,16 +309,8 @@ Study read_study(const fs::path& file) {
   }
 
   // The metrics: cycles.csv columns (all of them by default).
-  std::vector<std::string> columns;
-  for (const auto& [name, value] : metric_table(CycleMetrics{})) columns.push_back(name);
-  // The per-pair coaptation columns follow the scene's coaptation probe (pairs of list positions A < B).
-  for (const auto& probe : base.scene.probes)
-    if (!base.scene.cycle->coaptation.empty() && probe.name == base.scene.cycle->coaptation)
-      for (std::size_t a = 0; a < probe.bodies.size(); ++a)
-        for (std::size_t b = a + 1; b < probe.bodies.size(); ++b)
-          for (const char* what : {"height", "length"})
-            columns.push_back(std::string("coaptation_") + what + "_" + std::to_string(a) + "_" +
-                              std::to_string(b) + "_mm");
+  // The per-pair, per-commissure and per-cusp columns follow the scene's probes (app/cycle_report.cpp).
+  const std::vector<std::string> columns = cycle_metric_names(base.scene);
   if (j.contains("metrics")) {
     if (!j["metrics"].is_array() || j["metrics"].empty())
       fail(s, "metrics", "expected a list of column names");
@@ -618,7 +613,8 @@ int cmd_study(const std::vector<std::string>& args) {
   info["report"] = s.report;
   info["parameters"] = json::array();
   for (const auto& p : s.parameters)
-    info["parameters"].push_back({{"paths", p.paths}, {"labels", p.labels}, {"values", p.values}});
+    info["parameters"].push_back(
+        {{"paths", p.paths}, {"labels", p.labels}, {"values", p.values}, {"base", p.base}});
   info["variants"] = json::array();
   for (const auto& v : variants) info["variants"].push_back({{"id", v.id}, {"sets", v.sets}});
   write_if_changed(dir / "study.json", info.dump(2) + "\n");

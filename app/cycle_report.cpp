@@ -83,10 +83,27 @@ std::vector<std::pair<std::string, std::string>> probe_columns_of_block(const Sc
   if (!c.stress.empty())
     for (const char* f : {"max", "mean", "p95", "strain_max"})
       out.emplace_back("cycle.stress", c.stress + "." + f);
+  if (!c.stress.empty())
+    if (const Probe* p = probe_named(s, c.stress); p && p->per_body)
+      for (std::size_t b = 0; b < p->bodies.size(); ++b)
+        for (const std::string& f : stress_body_columns(b))
+          out.emplace_back("cycle.stress", c.stress + "." + f);
   if (!c.coaptation.empty())
     if (const Probe* p = probe_named(s, c.coaptation))
-      for (const std::string& f : coaptation_columns(p->bodies.size()))
+      for (const std::string& f : coaptation_columns(p->bodies.size(), p->per_body))
         out.emplace_back("cycle.coaptation", c.coaptation + "." + f);
+  if (!c.gap_area.empty())
+    if (const Probe* p = probe_named(s, c.gap_area)) {
+      out.emplace_back("cycle.gap_area", c.gap_area + ".central");
+      for (std::size_t k = 0; k < p->commissures.size(); ++k)
+        out.emplace_back("cycle.gap_area", c.gap_area + ".commissural_" + std::to_string(k));
+    }
+  if (!c.wall_distance.empty())
+    if (const Probe* p = probe_named(s, c.wall_distance)) {
+      out.emplace_back("cycle.wall_distance", c.wall_distance + ".min");
+      for (std::size_t k = 0; k < p->bodies.size(); ++k)
+        out.emplace_back("cycle.wall_distance", c.wall_distance + ".min_" + std::to_string(k));
+    }
   return out;
 }
 
@@ -166,6 +183,30 @@ std::vector<CycleMetrics> cycle_metrics_of(const Scene& s, const CsvTable& table
         }
       sig.central_height = col(c.coaptation + ".central_height");
       sig.effective_height = col(c.coaptation + ".effective_height");
+      if (p->per_body)
+        for (std::size_t k = 0; k < n; ++k)
+          sig.effective_height_cusp.push_back(col(c.coaptation + ".effective_height_" + std::to_string(k)));
+    }
+  if (!c.stress.empty())
+    if (const Probe* p = probe_named(s, c.stress); p && p->per_body)
+      for (std::size_t b = 0; b < p->bodies.size(); ++b) {
+        const std::string k = c.stress + "." + std::to_string(b);
+        sig.cusp_stress_max.push_back(col(k + ".max"));
+        sig.cusp_stress_p95.push_back(col(k + ".p95"));
+        sig.cusp_peak_height.push_back(col(k + ".max_height"));
+        sig.cusp_peak_s.push_back(col(k + ".max_s"));
+      }
+  if (!c.gap_area.empty())
+    if (const Probe* p = probe_named(s, c.gap_area)) {
+      sig.gap_central = col(c.gap_area + ".central");
+      for (std::size_t k = 0; k < p->commissures.size(); ++k)
+        sig.gap_commissural.push_back(col(c.gap_area + ".commissural_" + std::to_string(k)));
+    }
+  if (!c.wall_distance.empty())
+    if (const Probe* p = probe_named(s, c.wall_distance)) {
+      sig.wall_min = col(c.wall_distance + ".min");
+      for (std::size_t k = 0; k < p->bodies.size(); ++k)
+        sig.wall_min_cusp.push_back(col(c.wall_distance + ".min_" + std::to_string(k)));
     }
   CycleOptions o;
   o.period = c.period;
@@ -176,6 +217,34 @@ std::vector<CycleMetrics> cycle_metrics_of(const Scene& s, const CsvTable& table
   std::vector<CycleMetrics> out = all_cycle_metrics(sig, o);
   if (c.cycles > 0 && static_cast<int>(out.size()) > c.cycles) out.resize(c.cycles);
   return out;
+}
+
+std::vector<std::string> cycle_metric_names(const Scene& s) {
+  // The metrics of no cycle, shaped as the scene's would be: metric_table names them.
+  CycleMetrics m;
+  if (s.cycle) {
+    const CycleSpec& c = *s.cycle;
+    if (const Probe* p = c.coaptation.empty() ? nullptr : probe_named(s, c.coaptation))
+      for (std::size_t a = 0; a < p->bodies.size(); ++a)
+        for (std::size_t b = a + 1; b < p->bodies.size(); ++b) {
+          m.pair_names.push_back(std::to_string(a) + "_" + std::to_string(b));
+          m.coaptation_height_mm.push_back(0.0);
+          m.coaptation_length_mm.push_back(0.0);
+        }
+    if (const Probe* p = c.coaptation.empty() ? nullptr : probe_named(s, c.coaptation); p && p->per_body)
+      m.effective_height_mm_per.assign(p->bodies.size(), 0.0);
+    if (const Probe* p = c.gap_area.empty() ? nullptr : probe_named(s, c.gap_area))
+      m.commissural_gap_area_mm2_per.assign(p->commissures.size(), 0.0);
+    if (const Probe* p = c.stress.empty() ? nullptr : probe_named(s, c.stress); p && p->per_body) {
+      m.cusp_systole.assign(p->bodies.size(), {});
+      m.cusp_diastole.assign(p->bodies.size(), {});
+    }
+    if (const Probe* p = c.wall_distance.empty() ? nullptr : probe_named(s, c.wall_distance))
+      m.leaflet_wall_min_systole_mm_per.assign(p->bodies.size(), 0.0);
+  }
+  std::vector<std::string> names;
+  for (const auto& [name, value] : metric_table(m)) names.push_back(name);
+  return names;
 }
 
 void write_cycles_csv(const fs::path& file, const std::vector<CycleMetrics>& cycles) {

@@ -30,6 +30,10 @@ void check_cycle_columns(const Scene& scene, const std::vector<std::string>& pro
 // The metrics of every complete cycle in the table (probes.csv with a `time` column).
 std::vector<CycleMetrics> cycle_metrics_of(const Scene& scene, const CsvTable& probes);
 
+// The cycles.csv column names of the scene's cycle block (the per-pair, per-commissure and per-cusp columns
+// follow its probes), in cycles.csv order.
+std::vector<std::string> cycle_metric_names(const Scene& scene);
+
 // Writes cycles.csv (one row per cycle, empty cells where a metric is not measurable).
 void write_cycles_csv(const std::filesystem::path& file, const std::vector<CycleMetrics>& cycles);
 

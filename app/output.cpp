@@ -131,6 +131,17 @@ void VtkWriter::write(const World& world, int frame) {
   for (std::size_t i = 0; i < n; ++i) f << P.body[i] << '\n';
   f << "</DataArray>\n<DataArray type=\"Int32\" Name=\"id\" format=\"ascii\">\n";
   for (std::size_t i = 0; i < n; ++i) f << P.id[i] << '\n';
+  // Von Mises stress [Pa] of elastic solids (eqs. 16-17) and shells (the largest over a particle's Gauss
+  // points); zero for the other particles: the report's stress maps (scripts/study_report.py).
+  {
+    std::vector<double> vm(n, 0.0);
+    const Solids& S = world.solids();
+    for (std::size_t s = 0; s < S.size(); ++s) vm[S.at(s)] = S.von_mises(s);
+    for (std::size_t s = 0; s < world.shells().size(); ++s)
+      vm[world.shells().at(s)] = world.shells().von_mises(s);
+    f << "</DataArray>\n<DataArray type=\"Float64\" Name=\"von_mises\" format=\"ascii\">\n";
+    for (std::size_t i = 0; i < n; ++i) f << vm[i] << '\n';
+  }
   // Shells (sim/solid/shell.hpp): the director (the through-thickness direction), the mid-surface normal and
   // the thickness of each shell particle; zero for the others.
   if (const Shells& sh = world.shells(); !sh.empty()) {

@@ -531,6 +531,10 @@ class Loader {
     fail(path, "unknown material '" + name + "'");
   }
 
+  static bool identity_transform(const Body& b) {
+    return b.translate == Vec3::Zero() && b.rotate_degrees == 0.0;
+  }
+
   int body_index(const Scene& s, const std::string& name, const std::string& path) {
     for (std::size_t b = 0; b < s.bodies.size(); ++b)
       if (s.bodies[b].name == name) return static_cast<int>(b);
@@ -919,19 +923,23 @@ class Loader {
     if (type == "point") keys.insert(keys.end(), {"body", "reference"});
     if (type == "flow_rate") keys.insert(keys.end(), {"point", "normal", "radius"});
     if (type == "orifice_area") keys.insert(keys.end(), {"body", "bodies", "point", "normal", "radius"});
-    if (type == "stress" || type == "gap") keys.insert(keys.end(), {"bodies"});
+    if (type == "stress") keys.insert(keys.end(), {"bodies", "per_body", "point", "normal"});
+    if (type == "gap") keys.insert(keys.end(), {"bodies"});
+    if (type == "gap_area")
+      keys.insert(keys.end(), {"bodies", "point", "normal", "radius", "central_radius", "commissures"});
+    if (type == "wall_distance") keys.insert(keys.end(), {"bodies", "walls", "exclude", "reach"});
     if (type == "max_speed") keys.insert(keys.end(), {"bodies", "region"});
     if (type == "coaptation")
-      keys.insert(keys.end(), {"bodies", "point", "normal", "distance", "central_radius"});
+      keys.insert(keys.end(), {"bodies", "point", "normal", "distance", "central_radius", "per_leaflet"});
     if (type == "displacement") keys.insert(keys.end(), {"body", "point"});
     Obj o(j, path, keys, allowed);
     Probe p;
     p.name = o.string("name");
     if (p.name.empty() || p.name.find_first_of(",\"\n") != std::string::npos)
       fail(o.path("name"), "must be a non-empty name without commas or quotes");
-    o.choice("type",
-             {"extent", "pressure", "body", "point", "energy", "momentum", "flow_rate", "orifice_area",
-              "open_boundary", "stress", "gap", "max_speed", "coaptation", "displacement"});
+    o.choice("type", {"extent", "pressure", "body", "point", "energy", "momentum", "flow_rate",
+                      "orifice_area", "open_boundary", "stress", "gap", "max_speed", "coaptation",
+                      "displacement", "gap_area", "wall_distance"});
     if (type == "extent") {
       p.type = ProbeType::Extent;
       const auto names = o.strings("bodies");
@@ -986,6 +994,21 @@ class Loader {
             s.materials[s.bodies[p.bodies.back()].material].type != MaterialType::Shell)
           fail(index(o.path("bodies"), k), "body '" + names[k] + "' is not elastic: it carries no stress");
       }
+      // Per body (docs/valve-metrics.md): the valve frame the peak's place is given in; for aortic_root
+      // leaflets by default the root's annulus plane (its base, +y).
+      p.per_body = o.boolean("per_body", false);
+      if (!p.per_body && (o.has("point") || o.has("normal")))
+        fail(o.path(o.has("point") ? "point" : "normal"), "only with \"per_body\": true");
+      if (p.per_body) {
+        const Body& b0 = s.bodies[p.bodies.front()];
+        const bool root = b0.shape.kind == ShapeKind::AorticRoot && identity_transform(b0);
+        if (!root && !(o.has("point") && o.has("normal")))
+          fail(path,
+               "per_body needs 'point' and 'normal' (the annulus plane) unless the bodies are "
+               "untransformed aortic_root leaflets");
+        p.point = root ? o.vec3("point", b0.shape.aortic.base) : o.vec3("point");
+        p.normal = root ? o.unit("normal", Vec3::UnitY()) : o.unit("normal");
+      }
     } else if (type == "max_speed") {
       p.type = ProbeType::MaxSpeed;
       const auto names = o.strings("bodies", std::vector<std::string>{});
@@ -1013,6 +1036,68 @@ class Loader {
       p.normal = o.unit("normal");
       p.distance = o.positive("distance", 1.5 * s.spacing);
       p.central_radius = o.positive("central_radius", 2.0 * s.spacing);
+      p.per_body = o.boolean("per_leaflet", false);
+    } else if (type == "gap_area") {
+      // The orifice's open area split into the central part and one part per commissure.
+      p.type = ProbeType::GapArea;
+      const auto names = o.strings("bodies");
+      if (names.empty()) fail(o.path("bodies"), "expected at least one body");
+      for (std::size_t k = 0; k < names.size(); ++k)
+        p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
+      const Body& b0 = s.bodies[p.bodies.front()];
+      const bool root = b0.shape.kind == ShapeKind::AorticRoot && identity_transform(b0);
+      const std::optional<AorticRoot> geo =
+          root ? std::optional<AorticRoot>(AorticRoot(b0.shape.aortic)) : std::nullopt;
+      p.point = root ? o.vec3("point", b0.shape.aortic.base) : o.vec3("point");
+      p.normal = root ? o.unit("normal", Vec3::UnitY()) : o.unit("normal");
+      if (o.has("radius") || !root)
+        p.radius = o.positive("radius");
+      else
+        p.radius = geo->orifice_radius();
+      p.central_radius = o.positive("central_radius", p.radius / 3.0);
+      if (p.central_radius >= p.radius)
+        fail(o.path("central_radius"), "must be smaller than the radius (" + json(p.radius).dump() + " m)");
+      if (o.has("commissures")) {
+        const json& c = o.raw("commissures");
+        if (!c.is_array() || c.size() < 2 || c.size() > 16)
+          fail(o.path("commissures"), "expected a list of 2 to 16 points [x, y, z]");
+        for (std::size_t k = 0; k < c.size(); ++k) {
+          const json& q = c[k];
+          if (!q.is_array() || q.size() != 3 || !q[0].is_number() || !q[1].is_number() || !q[2].is_number())
+            fail(index(o.path("commissures"), k), "expected a point [x, y, z]");
+          const Vec3 x(q[0].get<double>(), q[1].get<double>(), q[2].get<double>());
+          const Vec3 rel = x - p.point;
+          if ((rel - rel.dot(p.normal) * p.normal).norm() < 1e-9)
+            fail(index(o.path("commissures"), k), "on the axis: it has no direction about it");
+          p.commissures.push_back(x);
+        }
+      } else if (root) {
+        // The root's commissures (AorticRoot: sector k starts at commissure k).
+        const AorticRootParams& g = geo->params();
+        for (int k = 0; k < 3; ++k)
+          p.commissures.push_back(
+              geo->to_world(g.commissure_radius, geo->sector_start(k), g.commissure_height));
+      } else {
+        fail(o.path("commissures"), "required unless the bodies are untransformed aortic_root leaflets");
+      }
+    } else if (type == "wall_distance") {
+      // The smallest distance from the leaflets to the wall (docs/valve-metrics.md).
+      p.type = ProbeType::WallDistance;
+      const auto names = o.strings("bodies");
+      if (names.empty()) fail(o.path("bodies"), "expected at least one body");
+      if (names.size() > 16) fail(o.path("bodies"), "expected at most 16 bodies");
+      for (std::size_t k = 0; k < names.size(); ++k)
+        p.bodies.push_back(body_index(s, names[k], index(o.path("bodies"), k)));
+      const auto walls = o.strings("walls");
+      if (walls.empty()) fail(o.path("walls"), "expected at least one body");
+      for (std::size_t k = 0; k < walls.size(); ++k) {
+        p.walls.push_back(body_index(s, walls[k], index(o.path("walls"), k)));
+        if (std::find(p.bodies.begin(), p.bodies.end(), p.walls.back()) != p.bodies.end())
+          fail(index(o.path("walls"), k), "body '" + walls[k] + "' is also in 'bodies'");
+      }
+      p.exclude = o.non_negative("exclude", 3.0 * s.spacing);
+      p.reach = o.positive("reach", 8.0 * s.spacing);
+      if (p.reach > 50.0 * s.spacing) fail(o.path("reach"), "at most 50 spacings");
     } else if (type == "gap") {
       p.type = ProbeType::Gap;
       const auto names = o.strings("bodies");
@@ -1060,9 +1145,9 @@ class Loader {
   }
 
   static std::vector<std::string> cycle_keys() {
-    return {"period",     "cycles",       "start",     "lv_pressure", "aortic_pressure",
-            "valve_flow", "orifice_area", "jet_speed", "lvot_flow",   "lvot_area",
-            "stress",     "coaptation",   "hold_level"};
+    return {"period",     "cycles",       "start",      "lv_pressure", "aortic_pressure",
+            "valve_flow", "orifice_area", "jet_speed",  "lvot_flow",   "lvot_area",
+            "stress",     "coaptation",   "hold_level", "gap_area",    "wall_distance"};
   }
 
   // The probe a column name belongs to: a probe `name` writes the column `name` (one-column probes) or
@@ -1123,6 +1208,8 @@ class Loader {
     };
     named_probe("stress", ProbeType::Stress, "stress", c.stress);
     named_probe("coaptation", ProbeType::Coaptation, "coaptation", c.coaptation);
+    named_probe("gap_area", ProbeType::GapArea, "gap_area", c.gap_area);
+    named_probe("wall_distance", ProbeType::WallDistance, "wall_distance", c.wall_distance);
     c.hold_level = o.non_negative("hold_level", 9332.57);
     for (const Material& m : s.materials)
       if (m.type == MaterialType::Fluid) {

@@ -226,6 +226,8 @@ enum class ProbeType {
   MaxSpeed,      // largest fluid speed in a region (the jet through a valve)
   Coaptation,    // leaflet coaptation heights and lengths, effective height (docs/valve-metrics.md)
   Displacement,  // displacement of the body particle nearest a point at t = 0
+  GapArea,       // the orifice's open area split into central and commissural parts (docs/valve-metrics.md)
+  WallDistance,  // how close the leaflets come to the wall (a leaflet striking a straight graft)
 };
 
 struct Probe {
@@ -245,7 +247,12 @@ struct Probe {
   Vec3 reference = Vec3::Zero();  // point
   double radius = 0.0;            // flow_rate, orifice_area
   double distance = 0.0;          // coaptation: contact distance [m]
-  double central_radius = 0.0;    // coaptation: radius about the axis counted as the centre [m]
+  double central_radius = 0.0;    // coaptation, gap_area: radius about the axis counted as the centre [m]
+  std::vector<Vec3> commissures;  // gap_area: the commissures (only their direction about the axis counts)
+  bool per_body = false;          // stress: per body max, p95 and the peak's place (docs/valve-metrics.md)
+  std::vector<int> walls;         // wall_distance: the wall bodies
+  double exclude = 0.0;           // wall_distance: leaflet particles this close to a wall at t = 0 left out
+  double reach = 0.0;             // wall_distance: distances are capped here [m]
 };
 
 enum class OpenBoundaryType { Inflow, Outflow };
@@ -342,6 +349,8 @@ struct CycleSpec {
   double lvot_area = 0.0;       // [m^2]; 0: from the lvot_flow (or valve_flow) probe's disc
   std::string stress;           // a stress probe's name
   std::string coaptation;       // a coaptation probe's name
+  std::string gap_area;         // a gap_area probe's name
+  std::string wall_distance;    // a wall_distance probe's name
   double hold_level = 9332.57;  // [Pa] diastolic pressure difference counted as held (70 mmHg)
   double density = 1060.0;      // [kg/m^3] fluid density for the Gorlin EOA
 };

@@ -14,6 +14,7 @@
 
 #include <catch2/catch.hpp>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -306,4 +307,236 @@ TEST_CASE("study: zipped, range and scale parameters cross into the variants of 
   CHECK(fs::exists(out / "Snakefile"));
   CHECK(!fs::exists(out / "variants" / "v000" / "run.json"));  // nothing ran
   CHECK(!fs::exists(out / "metrics.csv"));
+}
+
+namespace {
+
+// A synthetic study folder, as `aortasph study` leaves it after its runs, for scripts/study_report.py:
+// study.json, variants.csv and per variant run.json and cycles.csv (two cycles: the report reads the last).
+struct FakeVariant {
+  std::vector<nlohmann::json> values;  // per parameter (a list for a zipped one)
+  std::map<std::string, double> last;  // cycles.csv columns of the last cycle
+};
+
+void write_fake_study(const fs::path& dir, const nlohmann::json& parameters,
+                      const std::vector<FakeVariant>& vs) {
+  fs::create_directories(dir);
+  nlohmann::json study = {{"name", "fake"},
+                          {"title", "fake study"},
+                          {"description", ""},
+                          {"scene", "x.json"},
+                          {"fixed", nlohmann::json::array()},
+                          {"metrics", {"effective_height_mm"}},
+                          {"report", nlohmann::json::object()},
+                          {"parameters", parameters}};
+  std::ofstream(dir / "study.json") << study.dump(1);
+  std::ofstream table(dir / "variants.csv");
+  table << "id";
+  for (const auto& p : parameters)
+    for (const auto& l : p["labels"]) table << "," << l.get<std::string>();
+  table << "\n";
+  const nlohmann::json scene = {
+      {"resolution", {{"spacing", 0.001}}},
+      {"materials", {{"blood", {{"type", "fluid"}}}, {"leaf", {{"type", "shell"}, {"youngs_modulus", 2e6}}}}},
+      {"bodies", {{{"name", "blood"}, {"material", "blood"}}, {{"name", "leaflet0"}, {"material", "leaf"}}}},
+      {"open_boundaries", nlohmann::json::array()}};
+  for (std::size_t v = 0; v < vs.size(); ++v) {
+    char id[32];
+    std::snprintf(id, sizeof id, "v%03zu", v);
+    table << id;
+    for (const auto& val : vs[v].values)
+      for (const auto& x : val.is_array() ? val : nlohmann::json::array({val}))
+        table << "," << (x.is_string() ? x.get<std::string>() : x.dump());
+    table << "\n";
+    const fs::path vd = dir / "variants" / id;
+    fs::create_directories(vd);
+    std::ofstream(vd / "run.json") << nlohmann::json({{"status", "ok"}, {"scene", scene}}).dump();
+    std::ofstream c(vd / "cycles.csv");
+    c << "cycle";
+    for (const auto& [k, x] : vs[v].last) c << "," << k;
+    c << "\n0";
+    for (std::size_t k = 0; k < vs[v].last.size(); ++k) c << ",-999";  // the first cycle: not reported
+    c << "\n1";
+    for (const auto& [k, x] : vs[v].last) c << "," << x;
+    c << "\n";
+  }
+}
+
+int run_report(const fs::path& dir, std::string& output) {
+  const char* env = std::getenv("AORTASPH_PYTHON");
+  const std::string python = env && *env ? env : "/usr/bin/python3";
+  const auto f = dir / "report_log.txt";
+  const std::string cmd =
+      python + " " + kRepo + "/scripts/study_report.py " + dir.string() + " > " + f.string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  output = slurp(f);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// validation.csv as (sweep, metric) -> row.
+std::map<std::pair<std::string, std::string>, std::map<std::string, std::string>> validation_of(
+    const fs::path& dir) {
+  // Cells may hold commas inside quotes (csv module): read with a small quote-aware split.
+  std::ifstream in(dir / "validation.csv");
+  std::vector<std::vector<std::string>> rows;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> cells(1);
+    bool quoted = false;
+    for (char ch : line) {
+      if (ch == '"')
+        quoted = !quoted;
+      else if (ch == ',' && !quoted)
+        cells.emplace_back();
+      else
+        cells.back() += ch;
+    }
+    rows.push_back(cells);
+  }
+  std::map<std::pair<std::string, std::string>, std::map<std::string, std::string>> out;
+  for (std::size_t r = 1; r < rows.size(); ++r) {
+    const auto m = row_map(rows[0], rows[r]);
+    out[{m.at("sweep"), m.at("metric")}] = m;
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("study report: nomograms, stress maps and the validation table from synthetic graft variants",
+          "[study]") {
+  // Graft diameter 26 / 28 / 30 mm x straight / neo-sinus, with known trends: the effective height falls
+  // 0.25 mm per mm (Marom: falls: agree), the coaptation height rises 0.5 mm per mm (Marom: falls:
+  // disagree), the straight graft closes 10 ms sooner (Katayama: agree) and carries 20 kPa less stress
+  // (Katayama: more: disagree). The worst variant (largest diastolic cusp stress: 30 mm neo-sinus) has a VTK
+  // frame: its stress map is drawn from it.
+  const fs::path dir = scratch("study_report_graft") / "study";
+  const nlohmann::json params = {{{"paths", {"aortic_root.graft_diameter", "open_boundaries.1.radius"}},
+                                  {"labels", {"graft_diameter_m", "outlet_radius_m"}},
+                                  {"values", {{0.026, 0.013}, {0.028, 0.014}, {0.030, 0.015}}},
+                                  {"base", nullptr}},
+                                 {{"paths", {"aortic_root.graft_shape", "aortic_root.neo_sinus_bulge"}},
+                                  {"labels", {"graft_shape", "neo_sinus_bulge_m"}},
+                                  {"values", {{"straight", 0}, {"neo_sinus", 0.003}}},
+                                  {"base", nullptr}}};
+  std::vector<FakeVariant> vs;
+  for (double d : {26.0, 28.0, 30.0})
+    for (int neo = 0; neo < 2; ++neo) {
+      FakeVariant f;
+      f.values = {nlohmann::json::array({d / 1000, d / 2000}),
+                  neo ? nlohmann::json::array({"neo_sinus", 0.003}) : nlohmann::json::array({"straight", 0})};
+      const double coapt = 2.0 + 0.5 * (d - 26);
+      f.last = {{"effective_height_mm", 12.0 + 0.5 * neo - 0.25 * (d - 26)},
+                {"coaptation_height_0_1_mm", coapt - 0.2},
+                {"coaptation_height_0_2_mm", coapt},
+                {"coaptation_height_1_2_mm", coapt + 0.2},
+                {"closing_time_ms", 30.0 + 10.0 * neo},
+                {"stress_diastole_peak_kPa", 100.0 + 20.0 * neo + d},
+                {"stress_diastole_peak_c0_kPa", 100.0 + 20.0 * neo + d},
+                {"stress_diastole_peak_c1_kPa", 90.0},
+                {"stress_diastole_peak_c2_kPa", 80.0}};
+      vs.push_back(f);
+    }
+  write_fake_study(dir, params, vs);
+  const fs::path vtk = dir / "variants" / "v005" / "vtk";
+  fs::create_directories(vtk);
+  std::ofstream(vtk / "particles.pvd")
+      << "<VTKFile><Collection>\n<DataSet timestep=\"0.1\" file=\"particles_00001.vtp\"/>\n"
+         "<DataSet timestep=\"0.2\" file=\"particles_00002.vtp\"/>\n</Collection></VTKFile>\n";
+  std::ofstream(vtk / "particles_00002.vtp")
+      << "<VTKFile><PolyData><Piece><Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" "
+         "format=\"ascii\">\n0 0 0\n0.001 0.002 0.003\n0.002 0.001 0\n</DataArray>\n</Points><PointData>\n"
+         "<DataArray type=\"Int32\" Name=\"body\" format=\"ascii\">\n0\n1\n1\n</DataArray>\n"
+         "<DataArray type=\"Float64\" Name=\"von_mises\" format=\"ascii\">\n0\n1500\n3000\n</DataArray>\n"
+         "</PointData></Piece></PolyData></VTKFile>\n";
+  std::string output;
+  REQUIRE(run_report(dir, output) == 0);
+  INFO(output);
+  const std::string html = slurp(dir / "report.html");
+  CHECK(html.find("src='plots/nomogram.png'") != std::string::npos);
+  CHECK(fs::file_size(dir / "plots" / "nomogram.png") > 1000);
+  CHECK(html.find("Straight and neo-sinus grafts side by side") != std::string::npos);
+  CHECK(html.find("Worst variant: v005") != std::string::npos);
+  CHECK(html.find("src='plots/stress_map_v005.png'") != std::string::npos);
+  CHECK(fs::file_size(dir / "plots" / "stress_map_v005.png") > 1000);
+  CHECK(html.find("<h3>v000 (baseline)</h3><p>no VTK frame") != std::string::npos);
+  CHECK(html.find("http") == std::string::npos);
+
+  const auto val = validation_of(dir);
+  for (const std::string shape : {"straight", "neo_sinus"}) {
+    const std::string sweep = "graft diameter (" + shape + ")";
+    INFO(sweep);
+    REQUIRE(val.count({sweep, "effective height [mm per mm]"}));
+    const auto& eff = val.at({sweep, "effective height [mm per mm]"});
+    CHECK(eff.at("simulated_slope") == "-0.25");
+    CHECK(eff.at("simulated") == "falls");
+    CHECK(eff.at("published_slope") == "-0.29");
+    CHECK(eff.at("verdict") == "agree");
+    const auto& co = val.at({sweep, "coaptation height [mm per mm]"});
+    CHECK(co.at("simulated_slope") == "0.5");
+    CHECK(co.at("published_slope") == "-0.3");
+    CHECK(co.at("verdict") == "disagree");
+  }
+  const auto& closing = val.at({"graft shape", "closing time [ms]"});
+  CHECK(closing.at("simulated") == "straight - neo-sinus = -10 (mean of 3 pairs)");
+  CHECK(closing.at("verdict") == "agree");
+  CHECK(val.at({"graft shape", "diastolic peak stress [kPa]"}).at("verdict") == "disagree");
+}
+
+TEST_CASE(
+    "study report: the commissure-rotation panel and the commissure-height rows from synthetic variants",
+    "[study]") {
+  // Commissure height x0.8 / x1.0 of 16.8 mm crossed with commissure 1 at 120 / 130 degrees: the coaptation
+  // height grows 4 mm per unit factor (agree), the x0.8 valve regurgitates 8 % more (agree), the effective
+  // height falls 0.1 mm per degree of rotation and the stress rises 1 kPa per degree (no published value).
+  // No stress in any VTK frame: the stress maps fall back to the figure sheets, here none.
+  const fs::path dir = scratch("study_report_rotation") / "study";
+  const nlohmann::json params = {{{"paths", {"aortic_root.commissure_height"}},
+                                  {"labels", {"commissure_height_m"}},
+                                  {"values", {0.01344, 0.0168}},
+                                  {"base", 0.0168}},
+                                 {{"paths", {"aortic_root.commissure_angles.1"}},
+                                  {"labels", {"commissure_1_angle_deg"}},
+                                  {"values", {120, 130}},
+                                  {"base", 120}}};
+  std::vector<FakeVariant> vs;
+  for (double factor : {0.8, 1.0})
+    for (double angle : {120.0, 130.0}) {
+      const double delta = angle - 120.0;
+      FakeVariant f;
+      f.values = {factor * 0.0168, angle};
+      f.last = {{"coaptation_height_0_1_mm", 4.0 * factor},
+                {"regurgitant_fraction_pct", factor < 0.9 ? 10.0 : 2.0},
+                {"central_gap_area_mm2", factor < 0.9 ? 3.0 : 0.0},
+                {"commissural_gap_area_c0_mm2", 0.1 * delta},
+                {"effective_height_mm", 10.0 - 0.1 * delta},
+                {"effective_height_c0_mm", 10.0 - 0.1 * delta},
+                {"effective_height_c1_mm", 10.0 - 0.2 * delta},
+                {"stress_diastole_peak_kPa", 50.0 + delta},
+                {"stress_diastole_peak_c1_kPa", 50.0 + delta},
+                {"stress_diastole_p95_c1_kPa", 40.0 + delta}};
+      vs.push_back(f);
+    }
+  write_fake_study(dir, params, vs);
+  std::string output;
+  REQUIRE(run_report(dir, output) == 0);
+  INFO(output);
+  const std::string html = slurp(dir / "report.html");
+  CHECK(html.find("src='plots/commissure_rotation.png'") != std::string::npos);
+  CHECK(fs::file_size(dir / "plots" / "commissure_rotation.png") > 1000);
+  CHECK(html.find("not applicable: the study does not sweep the graft") != std::string::npos);
+  // The largest cusp stress, 60 kPa at 130 degrees, first reached by v001 (x0.8): the first of equals.
+  CHECK(html.find("Worst variant: v001") != std::string::npos);
+  const auto val = validation_of(dir);
+  const std::string sweep = "commissure height (factor of the base)";
+  REQUIRE(val.count({sweep, "coaptation height [mm per unit factor]"}));
+  CHECK(val.at({sweep, "coaptation height [mm per unit factor]"}).at("simulated_slope") == "4");
+  CHECK(val.at({sweep, "coaptation height [mm per unit factor]"}).at("verdict") == "agree");
+  const auto& leak = val.at({sweep, "leakage at x0.8"});
+  CHECK(leak.at("verdict") == "agree");
+  CHECK(leak.at("simulated") == "regurgitant_fraction_pct x0.8 - x1.0 = 8; central gap at x0.8 3 mm2");
+  const auto& rot = val.at({"commissure rotation delta", "effective height [mm per deg]"});
+  CHECK(rot.at("simulated_slope") == "-0.1");
+  CHECK(rot.at("verdict") == "no published value");
+  CHECK(val.at({"commissure rotation delta", "diastolic peak stress [kPa per deg]"}).at("simulated_slope") ==
+        "1");
 }

@@ -14,6 +14,7 @@
 #include "core/parallel.hpp"
 #include "cycle_report.hpp"
 #include "io/probes.hpp"
+#include "physiology/orifice.hpp"
 #include "physiology/valve_metrics.hpp"
 #include "scene_loader.hpp"
 #include "world.hpp"
@@ -379,4 +380,271 @@ TEST_CASE("stress probe: 95th percentile and peak strain of a sagging cantilever
   CHECK(v[2] == vm[static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(vm.size()))) - 1]);
   CHECK(v[3] == Approx(strain).epsilon(1e-12));
   CHECK(v[3] > 0.0);
+}
+
+TEST_CASE("valve metrics: gaps at peak diastolic load, stress per cusp with its place, leaflet-wall distance",
+          "[physiology]") {
+  // The synthetic cycle, with a 5 mmHg bump of the diastolic load peaking at 0.5 s: the gaps are read there.
+  CycleSignals s = synthetic({400e-6}, {80.0});
+  const std::size_t n = s.t.size();
+  s.gap_commissural.assign(3, {});
+  s.cusp_stress_max.assign(2, {});
+  s.cusp_stress_p95.assign(2, {});
+  s.cusp_peak_height.assign(2, {});
+  s.cusp_peak_s.assign(2, {});
+  s.wall_min_cusp.assign(2, {});
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = s.t[i];
+    s.lv_pressure[i] -= 5 * kPaPerMmHg * std::max(0.0, 1.0 - std::abs(t - 0.5) / 0.05);
+    s.gap_central.push_back(1e-6 * t);  // 1 mm^2 per s
+    for (int c = 0; c < 3; ++c) s.gap_commissural[c].push_back(1e-7 * (c + 1) * t);
+    // Cusp 0: stress rising linearly through the cycle (its peak in each phase at the phase's last sample);
+    // cusp 1: a spike of 200 kPa at 0.1 s (systole) and 0.6 s (diastole). The place follows the time.
+    s.cusp_stress_max[0].push_back(1e5 * t);
+    s.cusp_stress_p95[0].push_back(0.5e5 * t);
+    const bool spike = std::abs(t - 0.1) < 1e-9 || std::abs(t - 0.6) < 1e-9;
+    s.cusp_stress_max[1].push_back(spike ? 2e5 : 1e3);
+    s.cusp_stress_p95[1].push_back(spike ? 1e5 : 1e3);
+    for (int c = 0; c < 2; ++c) {
+      s.cusp_peak_height[c].push_back(0.01 * t);
+      s.cusp_peak_s[c].push_back(t);
+    }
+    // Leaflet-wall distance: 5 mm, dipping to 1 mm at 0.2 s (systole) and to 0.5 mm at 0.7 s (diastole,
+    // not counted); leaflet 1 stays at 3 mm.
+    const double d = 0.005 - 0.004 * std::max(0.0, 1.0 - std::abs(t - 0.2) / 0.02) -
+                     0.0045 * std::max(0.0, 1.0 - std::abs(t - 0.7) / 0.02);
+    s.wall_min.push_back(d);
+    s.wall_min_cusp[0].push_back(d);
+    s.wall_min_cusp[1].push_back(0.003);
+  }
+  CycleOptions o;
+  o.period = 0.8;
+  const CycleMetrics m = all_cycle_metrics(s, o).at(0);
+  CHECK(m.peak_load_time_ms == Approx(500.0).margin(1e-9));
+  CHECK(m.central_gap_area_mm2 == Approx(0.5).epsilon(1e-9));
+  REQUIRE(m.commissural_gap_area_mm2_per.size() == 3);
+  for (int c = 0; c < 3; ++c)
+    CHECK(m.commissural_gap_area_mm2_per[c] == Approx(0.05 * (c + 1)).epsilon(1e-9));
+  CHECK(m.commissural_gap_area_mm2 == Approx(0.3).epsilon(1e-9));
+  // Forward flow is [0, 0.3] s, closed from 0.336 s to the end (0.8 s).
+  REQUIRE(m.cusp_systole.size() == 2);
+  CHECK(m.cusp_systole[0].peak_kPa == Approx(30.0).epsilon(1e-6));
+  CHECK(m.cusp_systole[0].p95_kPa == Approx(15.0).epsilon(1e-6));
+  CHECK(m.cusp_systole[0].peak_height_mm == Approx(3.0).epsilon(1e-6));
+  CHECK(m.cusp_diastole[0].peak_kPa == Approx(80.0).epsilon(1e-6));
+  CHECK(m.cusp_diastole[0].peak_s == Approx(0.8).epsilon(1e-6));
+  CHECK(m.cusp_systole[1].peak_kPa == Approx(200.0).epsilon(1e-9));
+  CHECK(m.cusp_systole[1].peak_s == Approx(0.1).epsilon(1e-9));
+  CHECK(m.cusp_systole[1].peak_height_mm == Approx(1.0).epsilon(1e-9));
+  CHECK(m.cusp_diastole[1].peak_kPa == Approx(200.0).epsilon(1e-9));
+  CHECK(m.cusp_diastole[1].p95_kPa == Approx(100.0).epsilon(1e-9));
+  CHECK(m.cusp_diastole[1].peak_s == Approx(0.6).epsilon(1e-9));
+  CHECK(m.leaflet_wall_min_systole_mm == Approx(1.0).epsilon(1e-9));
+  REQUIRE(m.leaflet_wall_min_systole_mm_per.size() == 2);
+  CHECK(m.leaflet_wall_min_systole_mm_per[0] == Approx(1.0).epsilon(1e-9));
+  CHECK(m.leaflet_wall_min_systole_mm_per[1] == Approx(3.0).epsilon(1e-9));
+  // The columns, in cycles.csv.
+  const auto table = metric_table(m);
+  auto value = [&](const std::string& name) {
+    for (const auto& [k, v] : table)
+      if (k == name) return v;
+    FAIL("no column " << name);
+    return 0.0;
+  };
+  CHECK(value("commissural_gap_area_c2_mm2") == Approx(0.15).epsilon(1e-9));
+  CHECK(value("stress_diastole_peak_c1_s") == Approx(0.6).epsilon(1e-9));
+  CHECK(value("leaflet_wall_min_systole_c1_mm") == Approx(3.0).epsilon(1e-9));
+  // Without the probes: NaN, and no per-cusp columns.
+  const CycleMetrics bare = all_cycle_metrics(synthetic({400e-6}, {80.0}), o).at(0);
+  CHECK(std::isnan(bare.central_gap_area_mm2));
+  CHECK(std::isnan(bare.leaflet_wall_min_systole_mm));
+  CHECK(bare.cusp_systole.empty());
+  CHECK(metric_table(bare).size() == table.size() - 3 - 2 * 2 * 4 - 2);
+}
+
+TEST_CASE("gap_area: the open area split into the centre and the commissures", "[physiology]") {
+  // A disc of radius 10 mm covered by a square lattice of particles (0.5 mm) except two holes: a central one
+  // (radius 2 mm) and one of radius 1.5 mm at 6 mm from the centre towards commissure 1 (of three at 90,
+  // 210 and 330 degrees in the disc's plane). Central radius 3.33 mm. Each hole reads open inside its edge
+  // less the cover radius 0.75 dx.
+  const double dx = 0.0005, R = 0.01, rc = R / 3.0;
+  const Vec3 centre(0, 0, 0), normal(0, 1, 0);
+  // orifice_area's frame for normal +y (sim/physiology/orifice.cpp): u = x-hat x n, v = n x u.
+  const Vec3 u = Vec3::UnitX().cross(normal).normalized(), v = normal.cross(u);
+  auto dir = [&](double deg) { return Vec3(std::cos(deg * kPi / 180) * u + std::sin(deg * kPi / 180) * v); };
+  const std::vector<Vec3> comm = {0.012 * dir(90), 0.012 * dir(210), 0.012 * dir(330)};
+  const Vec3 hole2 = 0.006 * dir(210);
+  std::vector<Vec3> pts;
+  for (int i = -24; i <= 24; ++i)
+    for (int j = -24; j <= 24; ++j) {
+      const Vec3 p = (i * dx) * u + (j * dx) * v;
+      if (p.norm() < 0.002 || (p - hole2).norm() < 0.0015) continue;
+      pts.push_back(p + Vec3(0, 0.0003 * ((i + j) % 3), 0));  // off the plane: projected
+    }
+  const OrificeRegions r = orifice_regions(pts, dx, centre, normal, R, rc, comm);
+  INFO("total " << r.total * 1e6 << " mm2, central " << r.central * 1e6 << ", commissural "
+                << r.commissural[0] * 1e6 << " " << r.commissural[1] * 1e6 << " " << r.commissural[2] * 1e6);
+  CHECK(r.total == orifice_area(pts, dx, centre, normal, R));
+  CHECK(r.central + r.commissural[0] + r.commissural[1] + r.commissural[2] == Approx(r.total).epsilon(1e-12));
+  // The holes' open discs: radius minus the cover radius, minus up to one lattice step for where the lattice
+  // points fall (hole 1: the farthest removed point lies within 2 mm; its neighbours cover beyond).
+  const double cover = kOrificeCoverRadius * dx;
+  CHECK(r.central > kPi * std::pow(0.002 - cover - dx, 2));
+  CHECK(r.central < kPi * std::pow(0.002 - cover + dx, 2));
+  CHECK(r.commissural[1] > kPi * std::pow(0.0015 - cover - dx, 2));
+  CHECK(r.commissural[1] < kPi * std::pow(0.0015 - cover + dx, 2));
+  CHECK(r.commissural[0] == 0.0);
+  CHECK(r.commissural[2] == 0.0);
+  // Without commissures everything open is central; the ring outside the lattice (beyond 12 mm) is not on
+  // the disc.
+  const OrificeRegions none = orifice_regions(pts, dx, centre, normal, R, rc, {});
+  CHECK(none.central == r.total);
+}
+
+namespace {
+
+Material rubber_material() {
+  Material m;
+  m.name = "rubber";
+  m.type = MaterialType::Elastic;
+  m.density = 1000.0;
+  m.youngs_modulus = 2e4;
+  m.poisson_ratio = 0.3;
+  return m;
+}
+
+Body box_body(const std::string& name, int material, const Box& box) {
+  Body b;
+  b.name = name;
+  b.material = material;
+  b.shape.kind = ShapeKind::Box;
+  b.shape.box = box;
+  return b;
+}
+
+}  // namespace
+
+TEST_CASE("wall_distance probe: a plate falling onto a wall, the attached strip left out, the cap",
+          "[physiology]") {
+  // A free elastic plate 8 mm above a wall falls under gravity: its distance to the wall shrinks by g t^2 / 2
+  // (no stress in uniform free fall). A clamped strip 1 mm from the wall (within `exclude` at t = 0: an
+  // attachment) is left out: the minimum is the plate's. A second probe capped at 4 mm reads 4 mm.
+  Scene s;
+  s.name = "fall";
+  s.spacing = 0.002;
+  s.gravity = Vec3(0, -9.81, 0);
+  s.domain = {Vec3(-0.03, -0.02, -0.03), Vec3(0.03, 0.03, 0.03)};
+  Material wall;
+  wall.name = "wall";
+  wall.type = MaterialType::Wall;
+  s.materials = {rubber_material(), wall};
+  s.bodies = {box_body("floor", 1, {Vec3(-0.02, -0.006, -0.02), Vec3(0.02, 0.0, 0.02)}),
+              box_body("plate", 0, {Vec3(-0.02, 0.008, -0.012), Vec3(0.0, 0.012, 0.008)}),
+              box_body("strip", 0, {Vec3(-0.02, 0.0, 0.016), Vec3(0.02, 0.002, 0.02)})};
+  s.bodies[2].fixed = Box{Vec3(-0.03, -0.01, 0.015), Vec3(0.03, 0.01, 0.03)};
+  Probe p;
+  p.name = "wd";
+  p.type = ProbeType::WallDistance;
+  p.bodies = {1, 2};
+  p.walls = {0};
+  p.exclude = 3 * s.spacing;
+  p.reach = 0.02;
+  Probe capped = p;
+  capped.name = "wd4";
+  capped.reach = 0.004;
+  s.probes = {p, capped};
+  World w(s);
+  const ProbeSet probes(s, w);
+  REQUIRE(probes.columns() ==
+          std::vector<std::string>{"wd.min", "wd.min_0", "wd.min_1", "wd4.min", "wd4.min_0", "wd4.min_1"});
+  // Brute force over the plate's particles (the strip's are all within exclude of the wall at t = 0).
+  auto brute = [&]() {
+    const Particles& P = w.particles();
+    double best = 1e9;
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (P.body[i] == 1)
+        for (std::size_t j = 0; j < P.size(); ++j)
+          if (P.body[j] == 0) best = std::min(best, (P.x[i] - P.x[j]).norm());
+    return best;
+  };
+  const auto v0 = probes.measure(w);
+  const double d0 = brute();
+  INFO("t = 0: " << v0[0] * 1e3 << " mm (brute force " << d0 * 1e3 << " mm)");
+  CHECK(v0[0] == Approx(d0).epsilon(1e-12));
+  CHECK(v0[1] == v0[0]);
+  CHECK(std::isnan(v0[2]));  // the strip: attached, left out
+  CHECK(d0 > 0.006);
+  CHECK(v0[3] == Approx(0.004).epsilon(1e-12));  // capped
+  const double t = 0.02;
+  w.advance_to(t, [] { return true; });
+  const auto v1 = probes.measure(w);
+  INFO("t = " << w.time() << ": " << v1[0] * 1e3 << " mm");
+  CHECK(v1[0] == Approx(brute()).epsilon(1e-12));
+  CHECK(d0 - v1[0] == Approx(0.5 * 9.81 * w.time() * w.time()).epsilon(0.03));
+}
+
+TEST_CASE("stress probe per body: each beam's peak, 95th percentile and the peak's place", "[physiology]") {
+  // Two clamped rubber beams sagging under gravity, 80 and 40 mm long: per body, the max and p95 of its own
+  // particles, and the reference height and cusp fraction of the particle carrying the max.
+  struct OneThread {
+    int before = max_threads();
+    OneThread() { set_threads(1); }
+    ~OneThread() { set_threads(before); }
+  } one_thread;
+  Scene s;
+  s.name = "beams";
+  s.spacing = 0.005;
+  s.gravity = Vec3(0, -9.81, 0);
+  s.domain = {Vec3(-0.02, -0.05, -0.02), Vec3(0.1, 0.03, 0.06)};
+  s.materials = {rubber_material()};
+  s.bodies = {box_body("long", 0, {Vec3(-0.01, 0, 0), Vec3(0.08, 0.01, 0.01)}),
+              box_body("short", 0, {Vec3(-0.01, 0, 0.03), Vec3(0.04, 0.01, 0.04)})};
+  for (Body& b : s.bodies) b.fixed = Box{Vec3(-0.02, -0.05, -0.02), Vec3(0, 0.03, 0.06)};
+  Probe p;
+  p.name = "st";
+  p.type = ProbeType::Stress;
+  p.bodies = {0, 1};
+  p.per_body = true;
+  p.point = Vec3(0.1, 0.0, 0.02);  // the "axis": the vertical line x = 0.1, z = 0.02
+  p.normal = Vec3::UnitY();
+  s.probes = {p};
+  World w(s);
+  const ProbeSet probes(s, w);
+  REQUIRE(probes.columns().size() == 4 + 2 * 4);
+  CHECK(probes.columns()[4] == "st.0.max");
+  CHECK(probes.columns()[11] == "st.1.max_s");
+  w.advance_to(0.02, [] { return true; });
+  const auto v = probes.measure(w);
+  const Solids& S = w.solids();
+  const Particles& P = w.particles();
+  const Vec3 u = Vec3::UnitX().cross(p.normal).normalized(), vv = p.normal.cross(u);
+  auto angle = [&](const Vec3& x) { return std::atan2((x - p.point).dot(vv), (x - p.point).dot(u)); };
+  for (int b = 0; b < 2; ++b) {
+    std::vector<double> vm;
+    double best = -1, lo = 1e9, hi = -1e9;
+    Vec3 where = Vec3::Zero();
+    for (std::size_t k = 0; k < S.size(); ++k)
+      if (P.body[S.at(k)] == b) {
+        vm.push_back(S.von_mises(k));
+        if (S.von_mises(k) > best) {
+          best = S.von_mises(k);
+          where = P.x0[S.at(k)];
+        }
+      }
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (P.body[i] == b) {
+        lo = std::min(lo, angle(P.x0[i]));  // the beams lie on one side of the axis: no wrap
+        hi = std::max(hi, angle(P.x0[i]));
+      }
+    INFO("body " << b << ": max " << v[4 + 4 * b] << " Pa at height " << v[6 + 4 * b] << " m, s "
+                 << v[7 + 4 * b]);
+    CHECK(v[4 + 4 * b] == best);
+    CHECK(v[5 + 4 * b] == percentile_nearest_rank(vm, 95.0));
+    CHECK(v[6 + 4 * b] == Approx(where.y()).margin(1e-15));
+    CHECK(v[7 + 4 * b] == Approx((angle(where) - lo) / (hi - lo)).epsilon(1e-9));
+    CHECK(v[7 + 4 * b] >= 0.0);
+    CHECK(v[7 + 4 * b] <= 1.0);
+  }
+  // The overall max is the larger of the two bodies'.
+  CHECK(v[0] == std::max(v[4], v[8]));
 }

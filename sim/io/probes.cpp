@@ -2,10 +2,13 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <numbers>
+#include <utility>
 
 #include "core/neighbors.hpp"
 #include "core/parallel.hpp"
@@ -132,6 +135,7 @@ double largest_principal_strain(const Eigen::Matrix3d& F) {
 struct CoaptationStats {
   std::vector<double> height, length;  // per leaflet pair (a < b in list order)
   double central_height = 0.0, effective_height = 0.0;
+  std::vector<double> effective_per_leaflet;  // per leaflet: its highest particle near the axis (NaN: none)
 };
 
 // Coaptation of the listed leaflets (docs/valve-metrics.md): particles of two leaflets closer than the
@@ -168,6 +172,7 @@ CoaptationStats coaptation(const World& world, const Probe& pr) {
   const double inf = std::numeric_limits<double>::infinity();
   std::vector<double> zmin(pairs, inf), zmax(pairs, -inf), rmin(pairs, inf), rmax(pairs, -inf);
   double czmin = inf, czmax = -inf, top = -inf;
+  std::vector<double> top_of(nb_bodies, -inf);
   NeighborSearch nb;
   nb.build(x, pr.distance);
   auto mark = [&](std::size_t p, std::size_t i) {
@@ -181,7 +186,10 @@ CoaptationStats coaptation(const World& world, const Probe& pr) {
     }
   };
   for (std::size_t i = 0; i < x.size(); ++i) {
-    if (r[i] < pr.central_radius) top = std::max(top, z[i]);
+    if (r[i] < pr.central_radius) {
+      top = std::max(top, z[i]);
+      top_of[leaf[i]] = std::max(top_of[leaf[i]], z[i]);
+    }
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = nb.index()[k];
       if (j <= i || leaf[j] == leaf[i]) continue;
@@ -197,7 +205,68 @@ CoaptationStats coaptation(const World& world, const Probe& pr) {
   }
   c.central_height = czmax >= czmin ? czmax - czmin : 0.0;
   c.effective_height = std::isfinite(top) ? top : kNaN;
+  for (double t : top_of) c.effective_per_leaflet.push_back(std::isfinite(t) ? t : kNaN);
   return c;
+}
+
+// The unit vectors (u, v) of the plane normal to n, as orifice_area takes them (sim/physiology/orifice.cpp).
+void plane_frame(const Vec3& normal, Vec3& u, Vec3& v) {
+  const Vec3 n = normal.normalized();
+  u = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
+  v = n.cross(u);
+}
+
+// Angle in (-pi, pi].
+double wrap_angle(double a) {
+  while (a > std::numbers::pi) a -= 2.0 * std::numbers::pi;
+  while (a <= -std::numbers::pi) a += 2.0 * std::numbers::pi;
+  return a;
+}
+
+// Points binned in cubic cells of side `cell` (sorted by cell key, then by index: deterministic), for the
+// distance from a point to the nearest of them within one cell side.
+class PointGrid {
+ public:
+  PointGrid(std::vector<Vec3> pts, double cell) : pts_(std::move(pts)), cell_(cell) {
+    for (std::size_t i = 0; i < pts_.size(); ++i) keys_.emplace_back(key(cell_of(pts_[i])), i);
+    std::sort(keys_.begin(), keys_.end());
+  }
+  // min(cap, the distance from x to the nearest point); cap <= cell.
+  double nearest(const Vec3& x, double cap) const {
+    double best2 = cap * cap;
+    const std::array<long, 3> c = cell_of(x);
+    for (long dx = -1; dx <= 1; ++dx)
+      for (long dy = -1; dy <= 1; ++dy)
+        for (long dz = -1; dz <= 1; ++dz) {
+          const uint64_t k = key({c[0] + dx, c[1] + dy, c[2] + dz});
+          auto it = std::lower_bound(keys_.begin(), keys_.end(), std::pair<uint64_t, std::size_t>(k, 0));
+          for (; it != keys_.end() && it->first == k; ++it)
+            best2 = std::min(best2, (pts_[it->second] - x).squaredNorm());
+        }
+    return std::sqrt(best2);
+  }
+
+ private:
+  std::array<long, 3> cell_of(const Vec3& x) const {
+    return {static_cast<long>(std::floor(x.x() / cell_)), static_cast<long>(std::floor(x.y() / cell_)),
+            static_cast<long>(std::floor(x.z() / cell_))};
+  }
+  static uint64_t key(const std::array<long, 3>& c) {
+    const uint64_t off = 1u << 20, mask = (1u << 21) - 1;
+    return ((static_cast<uint64_t>(c[0] + off) & mask) << 42) |
+           ((static_cast<uint64_t>(c[1] + off) & mask) << 21) | (static_cast<uint64_t>(c[2] + off) & mask);
+  }
+  std::vector<Vec3> pts_;
+  double cell_;
+  std::vector<std::pair<uint64_t, std::size_t>> keys_;
+};
+
+// The particles of the listed bodies: current (or, reference, t = 0) positions.
+std::vector<Vec3> positions_of(const Particles& P, const std::vector<char>& in_set, bool reference) {
+  std::vector<Vec3> x;
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (in_set[P.body[i]] && !is_buffer(P.kind[i])) x.push_back(reference ? P.x0[i] : P.x[i]);
+  return x;
 }
 
 void add_columns(std::vector<std::string>& cols, const std::string& name,
@@ -235,7 +304,12 @@ double percentile_nearest_rank(std::vector<double> v, double q) {
   return v[k];
 }
 
-std::vector<std::string> coaptation_columns(std::size_t leaflets) {
+std::vector<std::string> stress_body_columns(std::size_t b) {
+  const std::string k = std::to_string(b);
+  return {k + ".max", k + ".p95", k + ".max_height", k + ".max_s"};
+}
+
+std::vector<std::string> coaptation_columns(std::size_t leaflets, bool per_leaflet) {
   std::vector<std::string> cols;
   for (std::size_t a = 0; a < leaflets; ++a)
     for (std::size_t b = a + 1; b < leaflets; ++b) {
@@ -245,12 +319,16 @@ std::vector<std::string> coaptation_columns(std::size_t leaflets) {
     }
   cols.push_back("central_height");
   cols.push_back("effective_height");
+  if (per_leaflet)
+    for (std::size_t a = 0; a < leaflets; ++a) cols.push_back("effective_height_" + std::to_string(a));
   return cols;
 }
 
 ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probes) {
   const Particles& P = world.particles();
   tracked_id_.assign(probes_.size(), 0);
+  cusp_frames_.assign(probes_.size(), {});
+  eligible_.assign(probes_.size(), {});
   for (std::size_t k = 0; k < probes_.size(); ++k) {
     const Probe& pr = probes_[k];
     switch (pr.type) {
@@ -288,7 +366,55 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
         break;
       case ProbeType::Stress:
         add_columns(columns_, pr.name, {"max", "mean", "p95", "strain_max"});
+        if (pr.per_body) {
+          // Per listed body b: max, p95 and the peak particle's place (stress_body_columns).
+          for (std::size_t b = 0; b < pr.bodies.size(); ++b)
+            for (const std::string& c : stress_body_columns(b)) columns_.push_back(pr.name + "." + c);
+          // The cusp frames at t = 0: the angle of the body's centroid about the axis, and its particles'
+          // angular span about that angle (the cusp from one commissure to the other).
+          Vec3 u, v;
+          plane_frame(pr.normal, u, v);
+          for (int body : pr.bodies) {
+            std::vector<char> one(world.bodies().size(), 0);
+            one[body] = 1;
+            const std::vector<Vec3> x0 = positions_of(P, one, true);
+            Vec3 c = Vec3::Zero();
+            for (const Vec3& x : x0) c += x;
+            if (!x0.empty()) c /= static_cast<double>(x0.size());
+            CuspFrame f;
+            f.theta_c = std::atan2((c - pr.point).dot(v), (c - pr.point).dot(u));
+            f.phi_min = std::numeric_limits<double>::infinity();
+            f.phi_max = -f.phi_min;
+            for (const Vec3& x : x0) {
+              const double phi =
+                  wrap_angle(std::atan2((x - pr.point).dot(v), (x - pr.point).dot(u)) - f.theta_c);
+              f.phi_min = std::min(f.phi_min, phi);
+              f.phi_max = std::max(f.phi_max, phi);
+            }
+            cusp_frames_[k].push_back(f);
+          }
+        }
         break;
+      case ProbeType::GapArea:
+        add_columns(columns_, pr.name, {"total", "central", "commissural"});
+        for (std::size_t c = 0; c < pr.commissures.size(); ++c)
+          columns_.push_back(pr.name + ".commissural_" + std::to_string(c));
+        break;
+      case ProbeType::WallDistance: {
+        columns_.push_back(pr.name + ".min");
+        for (std::size_t b = 0; b < pr.bodies.size(); ++b)
+          columns_.push_back(pr.name + ".min_" + std::to_string(b));
+        // The leaflet particles farther than `exclude` from the walls at t = 0 (the attachment left out).
+        const std::vector<char> walls = body_mask(world, pr.walls), leaflets = body_mask(world, pr.bodies);
+        const double cell = std::max(pr.exclude, world.scene().spacing);
+        const PointGrid grid(positions_of(P, walls, true), cell);
+        for (std::size_t i = 0; i < P.size(); ++i)
+          if (leaflets[P.body[i]] && !is_buffer(P.kind[i]) &&
+              (pr.exclude <= 0.0 || grid.nearest(P.x0[i], pr.exclude) >= pr.exclude))
+            eligible_[k].push_back(P.id[i]);
+        std::sort(eligible_[k].begin(), eligible_[k].end());
+        break;
+      }
       case ProbeType::Gap:
         add_columns(columns_, pr.name, {"min", "overlaps"});
         break;
@@ -296,7 +422,7 @@ ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probe
         columns_.push_back(pr.name);
         break;
       case ProbeType::Coaptation:
-        for (const std::string& c : coaptation_columns(pr.bodies.size()))
+        for (const std::string& c : coaptation_columns(pr.bodies.size(), pr.per_body))
           columns_.push_back(pr.name + "." + c);
         break;
       case ProbeType::Displacement: {
@@ -541,6 +667,40 @@ std::vector<double> ProbeSet::measure(const World& world) const {
           if (in_set[P.body[Sh.at(s)]]) vm.push_back(Sh.von_mises(s));
         out.insert(out.end(), {all.max, all.count > 0 ? all.sum / all.count : 0.0,
                                percentile_nearest_rank(vm, 95.0), strain});
+        if (pr.per_body) {
+          // Per body, in array order (solids, then shells): the largest value (the first particle on ties),
+          // the nearest-rank 95th percentile, and where the peak particle sits on its cusp at t = 0: its
+          // height above the annulus plane (point, normal) and its fraction s of the cusp's angular span
+          // (0 and 1 the cusp's ends at the commissures, 0.5 its middle).
+          Vec3 u, v;
+          plane_frame(pr.normal, u, v);
+          const Vec3 axis = pr.normal.normalized();
+          for (std::size_t b = 0; b < pr.bodies.size(); ++b) {
+            std::vector<double> vals;
+            double best = -1.0;
+            Vec3 where = Vec3::Constant(kNaN);
+            auto visit = [&](std::size_t particle, double value) {
+              if (P.body[particle] != pr.bodies[b]) return;
+              vals.push_back(value);
+              if (value > best) {
+                best = value;
+                where = P.x0[particle];
+              }
+            };
+            for (std::size_t s = 0; s < S.size(); ++s) visit(S.at(s), S.von_mises(s));
+            for (std::size_t s = 0; s < Sh.size(); ++s) visit(Sh.at(s), Sh.von_mises(s));
+            const CuspFrame& f = cusp_frames_[k][b];
+            double height = kNaN, frac = kNaN;
+            if (!vals.empty()) {
+              height = (where - pr.point).dot(axis);
+              const double phi =
+                  wrap_angle(std::atan2((where - pr.point).dot(v), (where - pr.point).dot(u)) - f.theta_c);
+              frac = f.phi_max > f.phi_min ? (phi - f.phi_min) / (f.phi_max - f.phi_min) : 0.5;
+            }
+            out.insert(out.end(), {vals.empty() ? kNaN : best,
+                                   vals.empty() ? kNaN : percentile_nearest_rank(vals, 95.0), height, frac});
+          }
+        }
         break;
       }
       case ProbeType::MaxSpeed: {
@@ -563,6 +723,8 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const CoaptationStats c = coaptation(world, pr);
         for (std::size_t k = 0; k < c.height.size(); ++k) out.insert(out.end(), {c.height[k], c.length[k]});
         out.insert(out.end(), {c.central_height, c.effective_height});
+        if (pr.per_body)
+          out.insert(out.end(), c.effective_per_leaflet.begin(), c.effective_per_leaflet.end());
         break;
       }
       case ProbeType::Displacement: {
@@ -571,6 +733,41 @@ std::vector<double> ProbeSet::measure(const World& world) const {
           if (P.id[i] == tracked_id_[k]) at = i;
         const Vec3 u = at == n ? Vec3::Constant(kNaN) : Vec3(P.x[at] - P.x0[at]);
         for (int d = 0; d < 3; ++d) out.push_back(u[d]);
+        break;
+      }
+      case ProbeType::GapArea: {
+        // The orifice_area raster split into central and commissural parts (sim/physiology/orifice.hpp).
+        const std::vector<char> in_set = body_mask(world, pr.bodies);
+        std::vector<Vec3> pts;
+        for (std::size_t i = 0; i < n; ++i)
+          if (in_set[P.body[i]]) pts.push_back(P.x[i]);
+        const OrificeRegions r = orifice_regions(pts, world.scene().spacing, pr.point, pr.normal, pr.radius,
+                                                 pr.central_radius, pr.commissures);
+        double comm = 0.0;
+        for (double a : r.commissural) comm += a;
+        out.insert(out.end(), {r.total, r.central, comm});
+        out.insert(out.end(), r.commissural.begin(), r.commissural.end());
+        break;
+      }
+      case ProbeType::WallDistance: {
+        // Smallest distance from a leaflet particle (those farther than `exclude` from the walls at t = 0)
+        // to a wall particle, now; capped at `reach`. Minima: independent of the visiting order.
+        const std::vector<char> walls = body_mask(world, pr.walls);
+        const PointGrid grid(positions_of(P, walls, false), pr.reach);
+        std::vector<int> slot(world.bodies().size(), -1);
+        for (std::size_t b = 0; b < pr.bodies.size(); ++b) slot[pr.bodies[b]] = static_cast<int>(b);
+        std::vector<double> per(pr.bodies.size(), kNaN);
+        double all = kNaN;
+        const std::vector<uint32_t>& ok = eligible_[k];
+        for (std::size_t i = 0; i < n; ++i) {
+          const int b = slot[P.body[i]];
+          if (b < 0 || is_buffer(P.kind[i]) || !std::binary_search(ok.begin(), ok.end(), P.id[i])) continue;
+          const double d = grid.nearest(P.x[i], pr.reach);
+          per[b] = std::isnan(per[b]) ? d : std::min(per[b], d);
+          all = std::isnan(all) ? d : std::min(all, d);
+        }
+        out.push_back(all);
+        out.insert(out.end(), per.begin(), per.end());
         break;
       }
       case ProbeType::Gap: {

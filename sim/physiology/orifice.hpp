@@ -18,6 +18,19 @@ namespace aortasph {
 double orifice_area(const std::vector<Vec3>& points, double spacing, const Vec3& center, const Vec3& normal,
                     double radius);
 
+// The open area of orifice_area split into regions (probe `gap_area`, docs/valve-metrics.md): the open cells
+// (the same raster as orifice_area) within central_radius of the disc's centre are `central`; every other
+// open cell belongs to the commissure whose direction in the disc's plane (from the centre, projected) is
+// nearest its own by angle: commissural[k]. total = central + sum commissural = orifice_area. Without
+// commissures every open cell is central.
+struct OrificeRegions {
+  double total = 0.0, central = 0.0;
+  std::vector<double> commissural;  // per commissure [m^2]
+};
+OrificeRegions orifice_regions(const std::vector<Vec3>& points, double spacing, const Vec3& center,
+                               const Vec3& normal, double radius, double central_radius,
+                               const std::vector<Vec3>& commissures);
+
 // Cover radius of one particle, in particle spacings (see orifice_area).
 constexpr double kOrificeCoverRadius = 0.75;
 

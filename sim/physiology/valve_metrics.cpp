@@ -286,6 +286,63 @@ CycleMetrics cycle_metrics(const CycleSignals& s, double t0, double t1, const Cy
       closed && has(s.central_height) ? sample_mean(t, s.central_height, da, db) * 1e3 : kNaN;
   m.effective_height_mm =
       closed && has(s.effective_height) ? sample_mean(t, s.effective_height, da, db) * 1e3 : kNaN;
+  for (const Vec& e : s.effective_height_cusp)
+    m.effective_height_mm_per.push_back(closed ? sample_mean(t, e, da, db) * 1e3 : kNaN);
+
+  // Gap areas at peak diastolic load: at the sample in the closed phase where p_Ao - p_LV is largest (the
+  // first such sample), the central and commissural open areas of the gap_area probe.
+  m.peak_load_time_ms = m.central_gap_area_mm2 = m.commissural_gap_area_mm2 = kNaN;
+  double t_load = kNaN;
+  if (pressures && closed) {
+    double best = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (t[i] >= da && t[i] <= db && s.aortic_pressure[i] - s.lv_pressure[i] > best) {
+        best = s.aortic_pressure[i] - s.lv_pressure[i];
+        t_load = t[i];
+      }
+    if (!std::isnan(t_load)) m.peak_load_time_ms = (t_load - t0) * 1e3;
+  }
+  const bool load = !std::isnan(t_load);
+  if (has(s.gap_central) && load) {
+    m.central_gap_area_mm2 = sample(t, s.gap_central, t_load) * 1e6;
+    m.commissural_gap_area_mm2 = 0.0;
+  }
+  for (const Vec& g : s.gap_commissural) {
+    const double a = load ? sample(t, g, t_load) * 1e6 : kNaN;
+    m.commissural_gap_area_mm2_per.push_back(a);
+    if (has(s.gap_central) && load) m.commissural_gap_area_mm2 += a;
+  }
+
+  // Per cusp: the largest max and p95 over the samples of a phase, and the peak's place at that sample.
+  auto cusp_phase = [&](std::size_t c, double a, double b) {
+    CycleMetrics::CuspStress r{kNaN, kNaN, kNaN, kNaN};
+    if (!(b >= a)) return r;
+    double best = -1.0, best95 = -1.0;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (t[i] < a || t[i] > b) continue;
+      const double v = s.cusp_stress_max[c][i], v95 = s.cusp_stress_p95[c][i];
+      if (!std::isnan(v) && v > best) {
+        best = v;
+        r.peak_kPa = v / 1e3;
+        r.peak_height_mm = s.cusp_peak_height[c][i] * 1e3;
+        r.peak_s = s.cusp_peak_s[c][i];
+      }
+      if (!std::isnan(v95) && v95 > best95) {
+        best95 = v95;
+        r.p95_kPa = v95 / 1e3;
+      }
+    }
+    return r;
+  };
+  for (std::size_t c = 0; c < s.cusp_stress_max.size(); ++c) {
+    m.cusp_systole.push_back(cusp_phase(c, sa, sb));
+    m.cusp_diastole.push_back(cusp_phase(c, da, db));
+  }
+
+  // Leaflet-wall distance: the smallest during forward flow (systole).
+  m.leaflet_wall_min_systole_mm = has(s.wall_min) && ejection ? min_in(t, s.wall_min, sa, sb) * 1e3 : kNaN;
+  for (const Vec& w : s.wall_min_cusp)
+    m.leaflet_wall_min_systole_mm_per.push_back(ejection ? min_in(t, w, sa, sb) * 1e3 : kNaN);
 
   m.sv_change_pct = m.edp_change_pct = kNaN;
   m.periodic = false;
@@ -358,6 +415,27 @@ std::vector<std::pair<std::string, double>> metric_table(const CycleMetrics& m) 
   }
   r.emplace_back("central_coaptation_height_mm", m.central_coaptation_height_mm);
   r.emplace_back("effective_height_mm", m.effective_height_mm);
+  for (std::size_t c = 0; c < m.effective_height_mm_per.size(); ++c)
+    r.emplace_back("effective_height_c" + std::to_string(c) + "_mm", m.effective_height_mm_per[c]);
+  r.emplace_back("peak_load_time_ms", m.peak_load_time_ms);
+  r.emplace_back("central_gap_area_mm2", m.central_gap_area_mm2);
+  r.emplace_back("commissural_gap_area_mm2", m.commissural_gap_area_mm2);
+  for (std::size_t c = 0; c < m.commissural_gap_area_mm2_per.size(); ++c)
+    r.emplace_back("commissural_gap_area_c" + std::to_string(c) + "_mm2", m.commissural_gap_area_mm2_per[c]);
+  for (const char* phase : {"systole", "diastole"}) {
+    const auto& cusps = std::string(phase) == "systole" ? m.cusp_systole : m.cusp_diastole;
+    for (std::size_t c = 0; c < cusps.size(); ++c) {
+      const std::string p = std::string("stress_") + phase + "_", k = "_c" + std::to_string(c);
+      r.emplace_back(p + "peak" + k + "_kPa", cusps[c].peak_kPa);
+      r.emplace_back(p + "p95" + k + "_kPa", cusps[c].p95_kPa);
+      r.emplace_back(p + "peak" + k + "_height_mm", cusps[c].peak_height_mm);
+      r.emplace_back(p + "peak" + k + "_s", cusps[c].peak_s);
+    }
+  }
+  r.emplace_back("leaflet_wall_min_systole_mm", m.leaflet_wall_min_systole_mm);
+  for (std::size_t c = 0; c < m.leaflet_wall_min_systole_mm_per.size(); ++c)
+    r.emplace_back("leaflet_wall_min_systole_c" + std::to_string(c) + "_mm",
+                   m.leaflet_wall_min_systole_mm_per[c]);
   r.emplace_back("sv_change_pct", m.sv_change_pct);
   r.emplace_back("edp_change_pct", m.edp_change_pct);
   r.emplace_back("periodic", m.cycle == 0 ? kNaN : (m.periodic ? 1.0 : 0.0));

@@ -28,6 +28,16 @@ struct CycleSignals {
   std::vector<std::string> pair_names;
   std::vector<std::vector<double>> coaptation_height, coaptation_length;
   std::vector<double> central_height, effective_height;
+  std::vector<std::vector<double>> effective_height_cusp;  // per leaflet (coaptation probe, per_leaflet)
+  // Gap areas (a gap_area probe) [m^2]: the central part and per commissure.
+  std::vector<double> gap_central;
+  std::vector<std::vector<double>> gap_commissural;
+  // Per cusp (a per_body stress probe): peak and 95th-percentile von Mises stress [Pa], the peak's height
+  // above the annulus plane [m] and fraction of the cusp's span [-].
+  std::vector<std::vector<double>> cusp_stress_max, cusp_stress_p95, cusp_peak_height, cusp_peak_s;
+  // Leaflet-wall distance (a wall_distance probe) [m]: over all leaflets and per leaflet.
+  std::vector<double> wall_min;
+  std::vector<std::vector<double>> wall_min_cusp;
 };
 
 struct CycleOptions {
@@ -57,6 +67,18 @@ struct CycleMetrics {
   std::vector<std::string> pair_names;
   std::vector<double> coaptation_height_mm, coaptation_length_mm;  // per pair
   double central_coaptation_height_mm = 0, effective_height_mm = 0;
+  std::vector<double> effective_height_mm_per;  // per cusp
+  // Gaps at peak diastolic load (the sample of largest p_Ao - p_LV while closed) [mm^2].
+  double peak_load_time_ms = 0, central_gap_area_mm2 = 0, commissural_gap_area_mm2 = 0;
+  std::vector<double> commissural_gap_area_mm2_per;  // per commissure
+  // Per cusp, in systole (forward flow) and diastole (closed): peak and p95 stress [kPa], where the peak is.
+  struct CuspStress {
+    double peak_kPa = 0, p95_kPa = 0, peak_height_mm = 0, peak_s = 0;
+  };
+  std::vector<CuspStress> cusp_systole, cusp_diastole;
+  // Smallest leaflet-wall distance during forward flow [mm]: over all leaflets and per leaflet.
+  double leaflet_wall_min_systole_mm = 0;
+  std::vector<double> leaflet_wall_min_systole_mm_per;
   // Periodic state, against the previous cycle (NaN for the first).
   double sv_change_pct = 0, edp_change_pct = 0;
   bool periodic = false;
