@@ -243,7 +243,8 @@ def nomograms(plt, root, rows, params, diam, shape):
             ax.set_ylabel(metric, fontsize=8)
             ax.set_title(("graft shape: %s" % s) if shape_label else metric.split(" [")[0], fontsize=9)
             ax.grid(True, alpha=0.3)
-            ax.legend(fontsize=6)
+            if ax.get_legend_handles_labels()[0]:
+                ax.legend(fontsize=6)
     fig.tight_layout()
     fig.savefig(os.path.join(root, "plots", "nomogram.png"), dpi=90)
     plt.close(fig)
@@ -300,7 +301,8 @@ def rotation_panel(plt, root, rows, rot):
             ax.text(0.5, 0.5, "not measured", ha="center", va="center", transform=ax.transAxes, color="gray")
         ax.set_xlabel("commissure rotation delta [deg]")
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=6)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=6)
     fig.tight_layout()
     fig.savefig(os.path.join(root, "plots", "commissure_rotation.png"), dpi=90)
     plt.close(fig)

@@ -13,6 +13,7 @@
 #include "cli_helpers.hpp"
 #include "core/parallel.hpp"
 #include "cycle_report.hpp"
+#include "geometry/aortic_root.hpp"
 #include "io/probes.hpp"
 #include "physiology/orifice.hpp"
 #include "physiology/valve_metrics.hpp"
@@ -647,4 +648,60 @@ TEST_CASE("stress probe per body: each beam's peak, 95th percentile and the peak
   }
   // The overall max is the larger of the two bodies'.
   CHECK(v[0] == std::max(v[4], v[8]));
+}
+
+TEST_CASE("gap_area, wall_distance and per-cusp stress on the aortic roots: volumetric and shell leaflets",
+          "[physiology][long]") {
+  // The closed valves at t = 0 of scenes/aortic_valve_cycle.json (volumetric leaflets; the probes as shipped,
+  // with the loader's defaults from the root) and scenes/aortic_root_shell.json (shell leaflets; the same
+  // probes added): the gap regions add up to the orifice area, every leaflet keeps particles beyond `exclude`
+  // from the wall (the distance is then at least `exclude`), and the peak stress's place lies on its cusp.
+  for (const std::string name : {"aortic_valve_cycle", "aortic_root_shell"}) {
+    INFO(name);
+    std::ifstream in(std::string(AORTASPH_TEST_DIR) + "/../scenes/" + name + ".json");
+    nlohmann::json j = nlohmann::json::parse(in);
+    if (name == "aortic_root_shell") {
+      const nlohmann::json leaf = {"leaflet0", "leaflet1", "leaflet2"};
+      for (auto& p : j["probes"])
+        if (p["name"] == "leaflet_stress") p["per_body"] = true;
+      j["probes"].push_back({{"name", "gaps"}, {"type", "gap_area"}, {"bodies", leaf}});
+      j["probes"].push_back(
+          {{"name", "leaflet_wall"}, {"type", "wall_distance"}, {"bodies", leaf}, {"walls", {"root"}}});
+    }
+    j.erase("render");
+    const Scene s = load_scene_json(j, {}).scene;
+    const World w(s);
+    const ProbeSet probes(s, w);
+    const auto v = probes.measure(w);
+    auto col = [&](const std::string& c) {
+      const auto& cols = probes.columns();
+      const auto it = std::find(cols.begin(), cols.end(), c);
+      REQUIRE(it != cols.end());
+      return v[static_cast<std::size_t>(it - cols.begin())];
+    };
+    const double dx = s.spacing;
+    INFO("orifice " << col("orifice") * 1e6 << " mm2, gaps central " << col("gaps.central") * 1e6
+                    << ", commissural " << col("gaps.commissural") * 1e6 << "; wall "
+                    << col("leaflet_wall.min") * 1e3 << " mm");
+    CHECK(col("gaps.total") == col("orifice"));
+    CHECK(col("gaps.central") + col("gaps.commissural") == Approx(col("gaps.total")).epsilon(1e-12));
+    CHECK(col("gaps.commissural_0") + col("gaps.commissural_1") + col("gaps.commissural_2") ==
+          Approx(col("gaps.commissural")).epsilon(1e-12));
+    const AorticRoot root(s.bodies[static_cast<std::size_t>(s.probes.back().bodies[0])].shape.aortic);
+    for (int k = 0; k < 3; ++k) {
+      const std::string K = std::to_string(k);
+      const double d = col("leaflet_wall.min_" + K);
+      CHECK(d >= 3 * dx - 1e-12);  // at t = 0 the kept particles are at least `exclude` from the wall
+      CHECK(d <= 8 * dx);
+      const double s_k = col("leaflet_stress." + K + ".max_s"),
+                   h = col("leaflet_stress." + K + ".max_height");
+      CHECK(s_k >= 0.0);
+      CHECK(s_k <= 1.0);
+      CHECK(h >= root.leaflet_lowest() - dx);
+      CHECK(h <= root.params().commissure_height + dx);
+      CHECK(col("leaflet_stress." + K + ".p95") <= col("leaflet_stress." + K + ".max"));
+    }
+    CHECK(col("leaflet_wall.min") ==
+          std::min({col("leaflet_wall.min_0"), col("leaflet_wall.min_1"), col("leaflet_wall.min_2")}));
+  }
 }
