@@ -705,3 +705,67 @@ TEST_CASE("gap_area, wall_distance and per-cusp stress on the aortic roots: volu
           std::min({col("leaflet_wall.min_0"), col("leaflet_wall.min_1"), col("leaflet_wall.min_2")}));
   }
 }
+
+TEST_CASE("gap_area, wall_distance and per_body probes: bad input exits 2 naming the JSON path",
+          "[physiology][bad-input]") {
+  // On the tube scene (no aortic root: nothing to default from), each probe appended after the tube's six.
+  const fs::path dir = scratch("valve_probe_bad");
+  const nlohmann::json disc = {{"point", {0, 0, 0}}, {"normal", {0, 1, 0}}};
+  auto gap = [&](const nlohmann::json& more) {
+    nlohmann::json p = {{"name", "g"}, {"type", "gap_area"}, {"bodies", {"tube"}}};
+    p.update(disc);
+    p.update(more);
+    return p;
+  };
+  auto wall = [](const nlohmann::json& more) {
+    nlohmann::json p = {{"name", "w"}, {"type", "wall_distance"}, {"bodies", {"blood"}}, {"walls", {"tube"}}};
+    p.update(more);
+    return p;
+  };
+  struct Case {
+    nlohmann::json probe;
+    std::string expect;
+  };
+  const std::vector<Case> cases = {
+      {gap({{"commissures", {{0.01, 0, 0}, {-0.01, 0, 0}}}}), "probes[6].radius: missing"},
+      {gap({{"radius", 0.01}}),
+       "probes[6].commissures: required unless the bodies are untransformed aortic_root"},
+      {gap({{"radius", 0.01}, {"commissures", {{0.01, 0, 0}, {0, 0.02, 0}}}}),
+       "probes[6].commissures[1]: on the axis"},
+      {gap({{"radius", 0.01}, {"commissures", {{0.01, 0, 0}}}}),
+       "probes[6].commissures: expected a list of 2 to 16"},
+      {gap({{"radius", 0.01}, {"central_radius", 0.01}, {"commissures", {{0.01, 0, 0}, {-0.01, 0, 0}}}}),
+       "probes[6].central_radius: must be smaller than the radius"},
+      {wall({{"walls", {"blood"}}}), "probes[6].walls[0]: body 'blood' is also in 'bodies'"},
+      {wall({{"reach", 1.0}}), "probes[6].reach: at most 50 spacings"},
+      {wall({{"walls", nlohmann::json::array()}}), "probes[6].walls: expected at least one body"},
+      {wall({{"exclude", -1.0}}), "probes[6].exclude"},
+      {{{"name", "c"},
+        {"type", "coaptation"},
+        {"bodies", {"blood", "tube"}},
+        {"point", {0, 0, 0}},
+        {"normal", {0, 1, 0}},
+        {"per_leaflet", 3}},
+       "probes[6].per_leaflet"},
+  };
+  for (const Case& c : cases) {
+    std::ifstream in(tube_cycle_scene(dir, good_cycle()));
+    nlohmann::json s = nlohmann::json::parse(in);
+    REQUIRE(s["probes"].size() == 6);
+    s["probes"].push_back(c.probe);
+    const fs::path file = dir / "probe_bad.json";
+    std::ofstream(file) << s.dump(1);
+    std::string err;
+    INFO(c.probe.dump());
+    CHECK(aortasph::test::run_cli("check " + file.string(), err) == 2);
+    INFO(err);
+    CHECK(err.find(c.expect) != std::string::npos);
+  }
+  // The cycle block's keys name probes of their own type.
+  nlohmann::json cycle = good_cycle();
+  cycle["gap_area"] = "q_mid";
+  cycle["wall_distance"] = "q_mid";
+  std::string err;
+  CHECK(run_cli("check " + tube_cycle_scene(dir, cycle).string(), err) == 2);
+  CHECK(err.find("cycle.gap_area: probe 'q_mid' is not a gap_area probe") != std::string::npos);
+}
