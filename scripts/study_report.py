@@ -260,10 +260,17 @@ def rotation_delta(row, rot):
     return v - b if b is not None else v
 
 
-def rotation_panel(plt, root, rows, rot):
+def rotation_panel(plt, root, rows, rot, params):
     """plots/commissure_rotation.png: per-cusp effective height, diastolic stress and the gap areas against
-    delta (the commissure's angle minus the base scene's)."""
-    fig, axes = plt.subplots(1, 3, figsize=(13.5, 3.6), squeeze=False)
+    delta (the commissure's angle minus the base scene's). When other parameters are swept too, the variants
+    with the first variant's values of them (named in the title)."""
+    other = [p["labels"][0] for j, p in enumerate(params) if j != rot[0]]
+    if other and rows:
+        key = [(l, rows[0][l]) for l in other]
+        rows = [r for r in rows if all(r[l] == v for l, v in key)]
+    fig, axes = plt.subplots(1, 3, figsize=(13.5, 3.8), squeeze=False)
+    if other:
+        fig.suptitle("at " + ", ".join("%s = %s" % kv for kv in key), fontsize=9)
     axes = axes[0]
     pts = sorted(((rotation_delta(r, rot), r) for r in rows if rotation_delta(r, rot) is not None),
                  key=lambda p: p[0])
@@ -663,7 +670,7 @@ def main():
     if plt is not None and diam:
         nomogram = nomograms(plt, root, rows, sparams, diam, shape)
     if plt is not None and rot:
-        rotation = rotation_panel(plt, root, rows, rot)
+        rotation = rotation_panel(plt, root, rows, rot, sparams)
     base_row = baseline_variant(rows, sparams)
     worst_row, worst_why = worst_variant(rows)
     maps = stress_maps(plt, root, rows, runs, base_row, worst_row) if base_row is not None else []
