@@ -1,5 +1,6 @@
 // Transport-velocity formulation for the fluid (issue 20): Adami, Hu & Adams 2013, "A transport-velocity
 // formulation for smoothed particle hydrodynamics", J. Comput. Phys. 241:292-307.
+// (The section numbers below are as recalled; the paper's text was not at hand when this was written.)
 //
 // Particles are advected with a transport velocity v~ that differs from their momentum velocity v by the
 // acceleration of a constant background pressure p_b, which pushes them from where they crowd to where they
