@@ -288,7 +288,7 @@ TEST_CASE(
     s.bodies[0].velocity = Vec3(1.0, 0.5, 0.0);
     World w(s);
     const Particles& P = w.particles();
-    for (int k = 0; k < 50; ++k) w.step(w.stable_dt());
+    for (int k = 0; k < 30; ++k) w.step(w.stable_dt());
     double worst = 0.0;
     const Periodic per(s.domain, s.periodic);
     for (std::size_t i = 0; i < P.size(); ++i)
@@ -300,7 +300,7 @@ TEST_CASE(
   for (int t = 1; t <= 2; ++t) {
     set_threads(t);
     World w(transport_scene(c, 10, 10.0));
-    for (int k = 0; k < 40; ++k) w.step(w.stable_dt());
+    for (int k = 0; k < 25; ++k) w.step(w.stable_dt());
     hash[t - 1] = state_hash(w);
   }
   set_threads(2);
