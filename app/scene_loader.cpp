@@ -428,7 +428,8 @@ class Loader {
                 "artificial_viscosity",
                 "density_summation",
                 "background_pressure",
-                "shifting"};
+                "shifting",
+                "transport_velocity"};
       else if (type == "elastic")
         keys = {"type",  "density", "youngs_modulus", "poisson_ratio", "hourglass", "artificial_viscosity",
                 "model", "gradient"};
@@ -451,6 +452,17 @@ class Loader {
         m.background_pressure = o.number("background_pressure", 0.0);
         m.shifting = o.non_negative("shifting", 0.0);
         if (m.shifting > 10.0) fail(o.path("shifting"), "must lie in 0..10 (Skillen et al. 2013 use 1..6)");
+        if (o.has("transport_velocity")) {  // Adami et al. 2013 (sim/fluid/transport_velocity.hpp)
+          Obj tv(o.raw("transport_velocity"), o.path("transport_velocity"), {"background_pressure"}, allowed);
+          m.transport_velocity_pb = tv.positive("background_pressure");
+          if (!m.density_summation)
+            fail(o.path("transport_velocity"),
+                 "needs \"density_summation\": true (the density must follow the transported particles, "
+                 "as in Adami et al. 2013)");
+          if (m.transport_velocity_pb > 1e3 * m.density * m.sound_speed * m.sound_speed)
+            fail(tv.path("background_pressure"),
+                 "must not exceed 1000 rho0 c0^2 (Adami et al. use rho0 c0^2)");
+        }
       } else if (type == "elastic") {
         m.type = MaterialType::Elastic;
         m.density = o.positive("density");

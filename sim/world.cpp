@@ -10,6 +10,7 @@
 #include "core/parallel.hpp"
 #include "core/sim_errors.hpp"
 #include "fluid/shifting.hpp"
+#include "fluid/transport_velocity.hpp"
 #include "geometry/shapes.hpp"
 
 namespace aortasph {
@@ -83,6 +84,7 @@ World::World(const Scene& scene)
     max_c0_ = std::max(max_c0_, mat.sound_speed);
     max_nu_ = std::max(max_nu_, mat.viscosity);
     shifting_ = shifting_ || mat.shifting > 0.0;
+    transport_ = transport_ || mat.transport_velocity_pb > 0.0;
   }
   if (!have_fluid) wall_ref_ = FluidParams(Material{});
 
@@ -403,6 +405,9 @@ void World::step(double dt) {
   profile_.boundary += seconds_since(t0);
 
   t0 = Clock::now();
+  // Transport velocity (Adami et al. 2013): v~ - v from the positions now, before the forces (its stress
+  // term enters them).
+  if (transport_) fluid_transport_velocity(P_, nb_, ctx, dt, ctx.transport_dv);
   fluid_forces(P_, nb_, ctx);  // eqs. (9), (10), artificial viscosity, gravity
   profile_.forces += seconds_since(t0);
 
@@ -460,6 +465,7 @@ void World::integrate(double dt) {
     if (P_.kind[i] != Kind::Fluid && P_.kind[i] != Kind::Elastic) return;
     P_.v[i] += kick * P_.a[i];
     P_.x[i] += dt * P_.v[i];
+    if (!ctx_.transport_dv.empty()) P_.x[i] += dt * ctx_.transport_dv[i];  // dr/dt = v~ (Adami et al. 2013)
     if (!shift_.empty()) P_.x[i] += shift_[i];
     if (per.any) per.wrap(P_.x[i]);  // out through one periodic face, in through the other
   });

@@ -230,6 +230,7 @@ class World {
   std::vector<Vec3> force_;   // per-particle force on body particles of the current step
   std::vector<Vec3> shift_;   // particle shifting of the current step (fluid/shifting.hpp); empty when off
   bool shifting_ = false;     // some fluid material shifts its particles
+  bool transport_ = false;    // some fluid material has the transport-velocity formulation
   std::vector<Vec3> moment_;  // and the moment of its contact forces about the particle (contact_dem.hpp)
   Profile profile_;
   double time_ = 0.0;

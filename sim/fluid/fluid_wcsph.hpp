@@ -31,6 +31,7 @@ struct FluidParams {
   double alpha = 0.0;
   double p_background = 0.0;
   double shifting = 0.0;  // particle shifting coefficient A (fluid/shifting.hpp)
+  double tv_pb = 0.0;     // transport-velocity background pressure p_b (fluid/transport_velocity.hpp)
   bool summation = false;
 
   explicit FluidParams(const Material& m)
@@ -43,6 +44,7 @@ struct FluidParams {
         alpha(m.artificial_viscosity),
         p_background(m.background_pressure),
         shifting(m.shifting),
+        tv_pb(m.transport_velocity_pb),
         summation(m.density_summation) {}
   FluidParams() = default;
 
@@ -68,6 +70,9 @@ struct FluidContext {
   // viscous term; empty when every body is no-slip.
   std::vector<uint8_t> free_slip = {};
   bool free_slip_of(uint32_t body) const { return !free_slip.empty() && free_slip[body]; }
+  // Per particle: the transport velocity's correction v~ - v of this step (fluid/transport_velocity.hpp),
+  // zero where a material has it off; empty when no material has it on.
+  std::vector<Vec3> transport_dv = {};
   // x_i - x_j, or its nearest image along periodic axes.
   Vec3 separation(const Vec3& xi, const Vec3& xj) const {
     return periodic.any ? periodic.image(xi - xj) : Vec3(xi - xj);
