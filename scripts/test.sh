@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # All tests: install, then a clang ASan+UBSan build runs the unit tests (left out: validation-size physics runs,
 # the aortic root in flow, [long] cases, runs of thousands of steps whose code paths shorter cases cover under
-# the sanitizers, and [heavy] cases, the nine that took 10-30 s each there at stop 23 (136 s of the step's 298 s)
-# while other cases cover their code under the sanitizers; they all run in the Release step), a ThreadSanitizer build runs the
+# the sanitizers, and [heavy] cases: nine that took 10-30 s each there at stop 23 (136 s of the step's 298 s),
+# and four more at stop 24 (the RCR outlet's ODE run, the parabolic tube, the SIGKILL resume and the shell-contact
+# thread comparison: 208 of the step's 760 s on the loaded machine), each while other cases cover its code under the
+# sanitizers; they all run in the Release step), a ThreadSanitizer build runs the
 # simulation-render pipeline test, a bounded libFuzzer run fuzzes the scene loader (scripts/fuzz.sh, built in the
 # same clang sanitizer tree), then the Release build (GCC) runs every test through CTest.
 # AORTASPH_SKIP_SANITIZE=1, AORTASPH_SKIP_TSAN=1, AORTASPH_SKIP_FUZZ=1 leave a step out.

@@ -282,7 +282,7 @@ void wait_for_file(const fs::path& p, pid_t pid) {
 }  // namespace
 
 TEST_CASE("checkpoint: a run killed by SIGKILL at a random moment resumes to identical outputs",
-          "[checkpoint][cli]") {
+          "[checkpoint][cli][heavy]") {
   const fs::path scene = scene_file();
   const Outputs& ref = reference(scene);
   std::random_device seed;

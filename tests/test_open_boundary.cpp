@@ -288,7 +288,7 @@ TEST_CASE("tube flow under gravity: a closed inflow holds the column at hydrosta
   CHECK(std::abs(mean(rows, 0.032, 0.064, &Row::q_mid)) < 0.02 * 0.1 * 52 * t.dx * t.dx);
 }
 
-TEST_CASE("tube flow: a parabolic inflow stays roughly parabolic mid-tube", "[open]") {
+TEST_CASE("tube flow: a parabolic inflow stays roughly parabolic mid-tube", "[open][heavy]") {
   TubeSetup t;
   t.parabolic = true;
   t.initial_velocity = 0.05;

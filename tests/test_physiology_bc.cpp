@@ -383,7 +383,7 @@ TEST_CASE("pressure inlet: a pressure drop drives Poiseuille flow through a tube
 }
 
 TEST_CASE("windkessel outlet: the outlet pressure follows the RCR ODE driven by the measured flow",
-          "[physiology]") {
+          "[physiology][heavy]") {
   // A velocity inlet pushes 0.1 m/s through the tube into an RCR outlet: R_d C = 18 ms, and a constant flow
   // would charge it by Q (R_p + R_d) = 18 Pa. The outlet's pressure is integrated here again, independently
   // (Crank-Nicolson at each fluid step), from the flow the outlet measured, and compared; and the fluid next

@@ -234,7 +234,7 @@ TEST_CASE("shell contact: the contact forces conserve linear momentum", "[shell_
   CHECK((p1 - p0).norm() < 1e-12 * p0.norm());
 }
 
-TEST_CASE("shell contact: 1 vs 2 threads bitwise identical", "[shell_contact]") {
+TEST_CASE("shell contact: 1 vs 2 threads bitwise identical", "[shell_contact][heavy]") {
   const int threads = max_threads();
   uint64_t h[2];
   for (int k = 0; k < 2; ++k) {
