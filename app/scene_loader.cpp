@@ -325,7 +325,7 @@ class Loader {
             "stj_height",     "aorta_radius",   "lvot_length",       "aorta_length",      "leaflet_free_edge",
             "leaflet_height", "leaflet_layers", "wall_layers",       "commissure_angles", "sinuses",
             "leaflet_shape",  "mirror_tilt",    "graft_diameter",    "graft_shape",       "neo_sinus_bulge",
-            "stj_diameter",   "cusps"};
+            "stj_diameter",   "cusps",          "commissure_post"};
   }
 
   // Reads the aortic_root parameters that o holds over p; with fill, every parameter, defaults written into
@@ -358,6 +358,8 @@ class Loader {
       p.mirror_leaflets = o.choice("leaflet_shape", {"labrosse", "mirror"},
                                    p.mirror_leaflets ? "mirror" : "labrosse") == "mirror";
     if (o.has("mirror_tilt")) p.mirror_tilt = o.number("mirror_tilt");
+    // Read only where given (no default written): the default follows the leaflets (shell or not).
+    if (o.has("commissure_post")) p.commissure_post = o.non_negative("commissure_post");
     surgical_params(o, p);
   }
 
@@ -502,7 +504,18 @@ class Loader {
       else
         volumetric = b;
     }
-    if (shells == 0) return;
+    if (shells == 0) {
+      // Commissure posts clamp shell leaflets to the wall: with volumetric leaflets there is none.
+      for (std::size_t b = 0; b < s.bodies.size(); ++b) {
+        const Shape& sh = s.bodies[b].shape;
+        if (sh.kind != ShapeKind::AorticRoot || !(sh.aortic.commissure_post > 0.0)) continue;
+        fail(shared_root_keys_.count("commissure_post")
+                 ? "aortic_root.commissure_post"
+                 : index("bodies", b) + ".shape.aortic_root.commissure_post",
+             "commissure posts need shell leaflets (a leaflet material of type shell)");
+      }
+      return;
+    }
     if (shells != leaflets)
       fail(index("bodies", volumetric) + ".material",
            "the aortic leaflets are shells or none is: this leaflet's material is not a shell, another's is");

@@ -109,6 +109,15 @@ struct AorticRootParams {
   // by the scene loader on every part of the root, so the leaflets sample one layer on their mid-surface and
   // the blood keeps its gap from that layer (sim/geometry/aortic_root.hpp).
   bool shell_leaflets = false;
+  // Commissure posts (shell leaflets; sim/geometry/aortic_root.hpp): within this distance [m] of each
+  // commissure's top point the two leaflets that meet there are clamped and the space between them (below
+  // both sheets) is wall. Negative: the default, commissure_post_default() for shell mirror leaflets, else 0.
+  double commissure_post = -1.0;
+  double commissure_post_length() const {
+    if (commissure_post >= 0.0) return commissure_post;
+    return shell_leaflets && mirror_leaflets ? commissure_post_default : 0.0;
+  }
+  static constexpr double commissure_post_default = 0.005;
   // Surgical geometry (issue 19 item 1; docs/scenes.md, sim/geometry/aortic_root.hpp surgical_root). Graft
   // mode: graft_diameter > 0 makes the root a graft of that inner diameter (commissure and sinotubular-
   // junction radius = graft_diameter / 2; the annulus keeps annulus_radius), straight or with neo-sinuses

@@ -58,6 +58,7 @@ std::vector<AorticRootParams> hash_roots() {
   mirror.aorta_length = 0.02;
   AorticRootParams shell = mirror;
   shell.shell_leaflets = true;
+  shell.commissure_post = 0.0;  // as recorded: before the commissure posts (on by default for shells since)
   AorticRootParams plain;
   plain.sinuses = false;
   plain.commissure_angles = {10.0, 115.0, 250.0};

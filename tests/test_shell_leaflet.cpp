@@ -66,7 +66,8 @@ double attachment_length(const AorticRoot& root, int k, int n = 2000) {
 TEST_CASE("shell leaflets: one layer on the mid-surface, normals, areas and clamped attachment rows",
           "[shell_leaflet][heavy]") {
   for (const bool mirrored : {false, true}) {
-    const AorticRootParams p = mirrored ? mirror() : labrosse();
+    AorticRootParams p = mirrored ? mirror() : labrosse();
+    p.commissure_post = 0.0;  // the attachment rows alone (the commissure posts: their own case below)
     const AorticRoot root(p);
     std::size_t count[2][3] = {};
     const double dxs[2] = {0.001, 0.0007};
@@ -201,6 +202,69 @@ TEST_CASE("shell leaflets: the blood stays half a spacing off the sheets, volume
   CHECK(v.points.size() > 2 * l[0].points.size());
 }
 
+TEST_CASE("shell leaflets: commissure posts clamp the leaflets there and leave no blood between them",
+          "[shell_leaflet]") {
+  const double dx = 0.001;
+  AorticRootParams p = mirror();  // shell mirror leaflets: the post is on by default
+  const double h = p.commissure_post_length();
+  REQUIRE(h == AorticRootParams::commissure_post_default);
+  const AorticRoot root(p);
+  const std::vector<Vec3> post = root.post_points(dx);
+  std::vector<ShapeSample> l;
+  for (int k = 0; k < 3; ++k) l.push_back(root.leaflet_shell(k, dx));
+  // Each commissure has its post, with particles on the coaptation plane between the two free edges.
+  for (int c = 0; c < 3; ++c) {
+    const Vec3 C = root.commissure_point(c);
+    const double phi = root.sector_start(c);
+    const Vec3 ew(std::sin(phi), 0.0, std::cos(phi));  // the plane's normal
+    int near = 0, on_plane = 0;
+    for (const Vec3& q : post) {
+      if ((q - C).norm() >= h) continue;
+      ++near;
+      on_plane += std::abs((q - p.base).dot(ew)) < 1e-9;
+    }
+    INFO("commissure " << c);
+    CHECK(near >= 5);
+    CHECK(on_plane >= 3);
+  }
+  // The post is part of the wall: appended to the rings.
+  AorticRootParams no_post = p;
+  no_post.commissure_post = 0.0;
+  const AorticRoot plain(no_post);
+  CHECK(plain.post_points(dx).empty());
+  SurfaceMesh mesh;
+  CHECK(root.wall_points(dx, &mesh).size() == plain.wall_points(dx, nullptr).size() + post.size());
+  // Leaflet particles within h of a commissure are clamped (more than without the post), and the post keeps
+  // half a spacing from them.
+  std::size_t clamped = 0, clamped_plain = 0;
+  for (int k = 0; k < 3; ++k) {
+    const ShapeSample s0 = plain.leaflet_shell(k, dx);
+    for (std::size_t i = 0; i < l[k].points.size(); ++i) {
+      clamped += l[k].clamped[i];
+      clamped_plain += s0.clamped[i];
+      for (int c = 0; c < 3; ++c)
+        if ((l[k].points[i] - p.base - root.commissure_point(c)).norm() < h) CHECK(l[k].clamped[i] == 1);
+      for (const Vec3& q : post) CHECK((q - l[k].points[i]).norm() >= 0.5 * dx);
+    }
+  }
+  CHECK(clamped > clamped_plain);
+  // No blood in the wedge: none in the post's region, none within 0.75 dx of a post particle; the blood
+  // without the post had points there.
+  const std::vector<Vec3> blood = root.blood_points(dx), blood_plain = plain.blood_points(dx);
+  std::size_t wedge = 0, wedge_plain = 0;
+  for (const Vec3& q : blood) {
+    wedge += root.in_post(q - p.base);
+    for (const Vec3& o : post) wedge += (o - q).norm() < 0.75 * dx;
+  }
+  for (const Vec3& q : blood_plain) wedge_plain += root.in_post(q - p.base);
+  CHECK(wedge == 0);
+  CHECK(wedge_plain > 0);
+  CHECK(blood.size() < blood_plain.size());
+  // Volumetric leaflets have none.
+  p.shell_leaflets = false;
+  CHECK(AorticRoot(p).post_points(dx).empty());
+}
+
 namespace {
 
 std::string replaced(std::string s, const std::string& from, const std::string& to) {
@@ -242,6 +306,17 @@ std::string valve_scene(double dx, const std::string& material_extra = "",
 })";
 }
 
+// The same three leaflets, volumetric (elastic), unloaded; extra: more aortic_root keys.
+std::string volumetric_valve(const std::string& extra) {
+  std::string s = valve_scene(0.001);
+  s = replaced(s, "\"aortic_root\": { ", "\"aortic_root\": { " + extra);
+  for (std::string::size_type at; (at = s.find("\"material\": \"leaf\"")) != std::string::npos;)
+    s.replace(at, 18, "\"material\": \"tissue\"");
+  const std::string load = ",\n      \"pressure_load\": [[0, 0], [0.006, -10700]]";
+  for (std::string::size_type at; (at = s.find(load)) != std::string::npos;) s.erase(at, load.size());
+  return s;
+}
+
 }  // namespace
 
 TEST_CASE("shell leaflets: the scene loader builds shell bodies, bad input exits 2 naming the key",
@@ -279,6 +354,16 @@ TEST_CASE("shell leaflets: the scene loader builds shell bodies, bad input exits
            R"("pressure_load": [[0, 0], [0.006, -10700]], "fixed": { "min": [1, 1, 1], "max": [2, 2, 2] } },
     { "name": "leaflet1")"),
        "bodies[0] 'leaflet0'.fixed: the region holds no particle of the body"},
+      {"commissure post on Labrosse shell leaflets",
+       replaced(valve_scene(0.001), "\"leaflet_shape\": \"mirror\"",
+                "\"leaflet_shape\": \"labrosse\", \"commissure_post\": 0.004"),
+       "aortic_root.commissure_post: needs mirror leaflets"},
+      {"commissure post longer than half the commissure radius",
+       replaced(valve_scene(0.001), "\"leaflet_shape\": \"mirror\"",
+                "\"leaflet_shape\": \"mirror\", \"commissure_post\": 0.007"),
+       "aortic_root.commissure_post: 0.007 is too long"},
+      {"commissure post with volumetric leaflets", volumetric_valve("\"commissure_post\": 0.004, "),
+       "aortic_root.commissure_post: commissure posts need shell leaflets"},
   };
   for (const Row& r : rows) {
     std::ofstream(dir / "scene.json") << r.scene;

@@ -399,6 +399,10 @@ std::vector<Vec3> AorticRoot::wall_points(double dx, SurfaceMesh* mesh) const {
     }
   }
 
+  // Commissure posts (shell leaflets): wall particles between the leaflets below each commissure.
+  if (p_.commissure_post_length() > 0.0)
+    for (const Vec3& q : post_points(dx)) out.push_back(q);
+
   if (mesh) {
     // Lumen surface: a grid over (y, theta), closed around the axis, open at both ends. Triangles are
     // counter-clockwise seen from the lumen (normals point to the axis, as for a tube's wall).
@@ -628,6 +632,7 @@ ShapeSample AorticRoot::leaflet_shell(int k, double dx) const {
           .cross(leaflet_surface(k, 0.5, 0.5 + e, inset) - leaflet_surface(k, 0.5, 0.5 - e, inset));
   const double sign = belly_n.y() < 0 ? -1.0 : 1.0;
   std::vector<std::size_t> kept, dropped;
+  const double post_len = p_.mirror_leaflets ? p_.commissure_post_length() : 0.0;
   for (std::size_t m = 0; m < mids.size(); ++m) {
     const Vec3& q = mids[m];
     const double r = std::hypot(q.x(), q.z()), th = std::atan2(-q.z(), q.x());
@@ -642,7 +647,11 @@ ShapeSample AorticRoot::leaflet_shell(int k, double dx) const {
     out.points.push_back(p_.base + q);
     out.normals.push_back(sign * normals[m]);
     out.areas.push_back(areas[m]);
-    out.clamped.push_back(row_of[m] == 0 || depth < kShellClampDepth * dx ? 1 : 0);
+    // Commissure posts: the leaflets are attached to each other and to the wall within the post's distance
+    // of a commissure (the tissue is continuous there in a real root).
+    bool post = false;
+    for (int c = 0; c < 3 && post_len > 0.0; ++c) post = post || (q - commissure_point(c)).norm() < post_len;
+    out.clamped.push_back(row_of[m] == 0 || depth < kShellClampDepth * dx || post ? 1 : 0);
   }
   // A point left out hands its area to the nearest kept point, so the areas still tile the mid-surface.
   for (std::size_t m : dropped) {
@@ -661,6 +670,77 @@ ShapeSample AorticRoot::leaflet_shell(int k, double dx) const {
 // Blood
 
 std::vector<Vec3> AorticRoot::blood_points(double dx) const {
+  return blood_lattice(dx);
+}
+
+std::vector<Vec3> AorticRoot::post_points(double dx) const {
+  // A grid aligned with each commissure's radial plane: columns dx apart inward from dx/2 inside the
+  // commissure radius, in each column rows dx apart downward from the free edge's height on the plane
+  // (where the two sheets' edge rows lie dx/2 either side of it), and points on the plane and dx, 2 dx either
+  // side of it. Kept: within the post's distance of the commissure point, dx/2 inside the lumen (normal
+  // distance), on the plane or dx/2 below the sheet of its sector, and 0.55 dx from every leaflet particle
+  // (the other bodies keep half a spacing).
+  std::vector<Vec3> post;
+  const double h = p_.commissure_post_length();
+  if (h <= 0.0 || !p_.mirror_leaflets) return post;
+  std::vector<Vec3> sheet;
+  for (int k = 0; k < 3; ++k)
+    for (const Vec3& q : leaflet_shell(k, dx).points) sheet.push_back(q - p_.base);
+  const int n = static_cast<int>(std::ceil(h / dx)) + 1;
+  for (int c = 0; c < 3; ++c) {
+    const Vec3 C = commissure_point(c);
+    const Vec3 er(std::cos(phi_[c]), 0.0, -std::sin(phi_[c])), ew(std::sin(phi_[c]), 0.0, std::cos(phi_[c]));
+    const int left = (c + 2) % 3;  // the leaflet ending at commissure c; leaflet c starts there
+    for (int a = 0; a < n; ++a) {
+      const double r = p_.commissure_radius - (a + 0.5) * dx;
+      const Vec3 on_plane = r * er;
+      const double y_edge = std::min(mirror_height(left, on_plane.x(), on_plane.z()),
+                                     mirror_height(c, on_plane.x(), on_plane.z()));
+      for (int j = 0; j < 2 * n; ++j)
+        for (int m = -2; m <= 2; ++m) {
+          const Vec3 q = on_plane + Vec3(0.0, y_edge - j * dx, 0.0) + (m * dx) * ew;
+          if ((q - C).squaredNorm() >= h * h) continue;
+          const double rq = std::hypot(q.x(), q.z()), th = std::atan2(-q.z(), q.x());
+          if ((lumen_radius(q.y(), th) - rq) / normal_scale(q.y(), th) < 0.5 * dx) continue;
+          double s = 0.0;
+          const int k = sector_of(th, s);
+          if (m != 0 && q.y() > mirror_height(k, q.x(), q.z()) - 0.5 * dx) continue;
+          bool clear = true;
+          for (const Vec3& o : sheet) clear = clear && (o - q).squaredNorm() >= 0.55 * 0.55 * dx * dx;
+          if (clear) post.push_back(p_.base + q);
+        }
+    }
+  }
+  return post;
+}
+
+Vec3 AorticRoot::commissure_point(int c) const {
+  const double th = phi_[c];
+  return Vec3(p_.commissure_radius * std::cos(th), p_.commissure_height,
+              -p_.commissure_radius * std::sin(th));
+}
+
+bool AorticRoot::in_post(const Vec3& x) const {
+  const double h = p_.commissure_post_length();
+  if (h <= 0.0 || !p_.mirror_leaflets) return false;
+  for (int c = 0; c < 3; ++c) {
+    if ((x - commissure_point(c)).squaredNorm() >= h * h) continue;
+    // Inside the lumen, below the closed sheet of the sector x lies in (the mirror surface of its leaflet,
+    // which the two leaflets' sheets follow up to dx/2 from the coaptation plane): the space between the two
+    // leaflets, on their ventricular side, and the corner they make with the wall.
+    const double th = std::atan2(-x.z(), x.x());
+    if (std::hypot(x.x(), x.z()) >= lumen_radius(x.y(), th)) return false;
+    double s = 0.0;
+    const int k = sector_of(th, s);
+    return x.y() < mirror_height(k, x.x(), x.z());
+  }
+  return false;
+}
+
+std::vector<Vec3> AorticRoot::blood_lattice(double dx) const {
+  const bool posts = p_.commissure_post_length() > 0.0 && p_.mirror_leaflets;
+  std::vector<Vec3> post_pts;
+  if (posts) post_pts = post_points(dx);
   // Leaflet particles in a hash grid of cell dx, to keep the blood kBloodGap dx away from them.
   std::unordered_map<int64_t, std::vector<Vec3>> grid;
   auto cell = [&](const Vec3& q) {
@@ -728,6 +808,12 @@ std::vector<Vec3> AorticRoot::blood_points(double dx) const {
         if (radial < 0.5 * dx || (radial < 4 * dx && radial / normal_scale(y, th) < 0.5 * dx)) continue;
         const Vec3 q = p_.base + Vec3(x, y, z);
         if (y >= leaf_lo && y <= leaf_hi && near_leaflet(q)) continue;
+        if (posts && in_post(q - p_.base)) continue;
+        if (posts) {  // and 0.75 dx from the post's particles
+          bool clear = true;
+          for (const Vec3& o : post_pts) clear = clear && (o - q).squaredNorm() >= 0.75 * 0.75 * dx * dx;
+          if (!clear) continue;
+        }
         out.push_back(q);
       }
   return out;
@@ -773,6 +859,12 @@ std::optional<AorticRootError> check_resolved(const AorticRootParams& p, double 
     if (p.annulus_radius >= p.sinus_radius)
       return err("sinus_radius", "must be larger than annulus_radius (" + num(p.annulus_radius) + ")");
   }
+  if (p.commissure_post > 0.0 && !p.mirror_leaflets)
+    return err("commissure_post", "needs mirror leaflets (leaflet_shape \"mirror\")");
+  if (!(p.commissure_post < 0.5 * p.commissure_radius) && p.commissure_post > 0.0)
+    return err("commissure_post",
+               num(p.commissure_post) +
+                   " is too long (less than commissure_radius / 2 = " + num(0.5 * p.commissure_radius) + ")");
   if (std::abs(p.mirror_tilt) > 30.0)
     return err("mirror_tilt", num(p.mirror_tilt) + " is outside [-30, 30] degrees");
   // Labrosse leaflets follow free_edge and leaflet_height; mirror leaflets follow the root alone.

@@ -54,6 +54,14 @@
 //  * Clamp: leaflet particles within dx of the lumen surface (normal distance, see normal_scale; the first
 //    row) are flagged clamped. Two rows also held the leaflet's slope, and the opening sheet folded beside
 //    them.
+//  * Commissure posts (shell mirror leaflets; commissure_post, default 5 mm, 0 = none): just below each
+//    commissure the two leaflets' free edges run up to the wall dx apart and, as the valve opens, the
+//    orifice's corner there is a wedge narrower than dx that the blood cannot resolve. In a real root the
+//    tissue is continuous there (the cusps attach side by side to the wall at the commissure, above the
+//    interleaflet triangle), so within commissure_post of the commissure's top point (commissure_radius,
+//    commissure_height) the leaflet particles are clamped and the space between the two sheets (on the
+//    coaptation plane between their free edges, and below both sheets) is wall particles (post_points);
+//    the blood leaves that space.
 //  * Wall: rings of particles at y levels (spaced dx, closer where the sinus wall is steep, so spacing along
 //    the wall stays <= dx), each ring wall_layers deep, layer j at R + (j + 1/2) dx (scaled by the wall's
 //    slope so the layers are dx apart along the normal); rings and layers staggered by half a spacing; ends
@@ -162,11 +170,24 @@ class AorticRoot {
   // it).
   ShapeSample leaflet_shell(int k, double dx) const;
   std::vector<Vec3> blood_points(double dx) const;
+  // Commissure posts (shell mirror leaflets, params().commissure_post_length() > 0): wall particles
+  // (appended to wall_points) filling, within that distance of each commissure's top point
+  // (commissure_point), the narrow space between the two leaflets that meet there: on the coaptation plane
+  // between their free edges and below both sheets, inside the lumen (the grid is in the .cpp). The blood
+  // leaves that region (in_post) and 0.75 dx round the post's particles.
+  std::vector<Vec3> post_points(double dx) const;
+  // Commissure c's top point (commissure_radius, commissure_height, angle c), root frame relative to base.
+  Vec3 commissure_point(int c) const;
+  // Whether x (root frame, relative to base) is in a commissure post's region (see post_points).
+  bool in_post(const Vec3& x) const;
 
   Vec3 to_world(double r, double theta, double y) const;
 
  private:
   double midline_length(double sag) const;
+  // The blood lattice (see blood_points), less the commissure posts' region and 0.75 dx round their
+  // particles.
+  std::vector<Vec3> blood_lattice(double dx) const;
   // Leaflet k's mid-surface points (root frame, relative to base), row by row, with the unit normals
   // d_rho x d_s (not oriented) and, if asked, the surface element of each point.
   void leaflet_mid_surface(int k, double dx, std::vector<Vec3>& mids, std::vector<Vec3>& normals,
