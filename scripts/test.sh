@@ -18,25 +18,61 @@ sanitize_tree() {
   scripts/build.sh build-san -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=ASan -DCMAKE_CXX_FLAGS_ASAN="-O1 -g1" \
     -DAORTASPH_SANITIZE=ON -DAORTASPH_FUZZ=ON
 }
+fuzz_run() { scripts/fuzz.sh "${AORTASPH_FUZZ_SECONDS:-60}" build-san; }
+fuzzed=0
 if [ "${AORTASPH_SKIP_SANITIZE:-0}" != 1 ]; then
   echo "== sanitizer build (clang, ASan + UBSan): unit tests"
   sanitize_tree
-  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ./build-san/tests/aortasph_tests "~[validation]~[flow]~[long]~[heavy]~[.]"
+  # The unit cases run as two single-threaded shards side by side (alternate cases in declaration order), and the
+  # fuzzer (one process, one thread, a fixed wall time) beside them: three single-threaded processes keep both
+  # cores busy, where one two-thread process left them partly idle. Two-thread OpenMP teams beside other work
+  # would spin against it (see the CTest step below). Cases that compare thread counts set their own.
+  filter="~[validation]~[flow]~[long]~[heavy]~[.]"
+  # (--list-test-names-only exits with the number of cases it listed: hence the `|| true`s; the count check
+  # below catches a listing that went wrong.)
+  { ./build-san/tests/aortasph_tests --list-test-names-only "$filter" || true; } | awk 'NF' > build-san/asan-cases.txt
+  pids=()
+  if [ "${AORTASPH_SKIP_FUZZ:-0}" != 1 ]; then
+    echo "== fuzzing the scene loader for ${AORTASPH_FUZZ_SECONDS:-60} s beside the unit tests (build-san/fuzz.log)"
+    fuzz_run > build-san/fuzz.log 2>&1 &
+    fuzz_pid=$!
+    fuzzed=1
+  fi
+  for k in 0 1; do
+    # Catch2 reads one test name per line; its spec syntax needs , [ ] * \ " escaped.
+    awk -v k=$k 'NR % 2 == k' build-san/asan-cases.txt | sed 's/[][,\\*"]/\\&/g' > build-san/asan-shard$k.txt
+    OMP_NUM_THREADS=1 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+      ./build-san/tests/aortasph_tests -f build-san/asan-shard$k.txt > build-san/asan-shard$k.log 2>&1 &
+    pids+=($!)
+  done
+  listed=$(cat build-san/asan-shard0.txt build-san/asan-shard1.txt |
+    { ./build-san/tests/aortasph_tests --list-test-names-only -f /dev/stdin || true; } | awk 'NF' | wc -l)
+  failed=0
+  for k in 0 1; do
+    if wait "${pids[$k]}"; then tail -n 3 build-san/asan-shard$k.log; else cat build-san/asan-shard$k.log; failed=1; fi
+  done
+  if [ "$fuzzed" = 1 ]; then
+    if wait "$fuzz_pid"; then tail -n 12 build-san/fuzz.log; else cat build-san/fuzz.log; failed=1; fi
+  fi
+  if [ "$listed" != "$(wc -l < build-san/asan-cases.txt)" ]; then
+    echo "the ASan shards hold $listed cases, the filter $(wc -l < build-san/asan-cases.txt)"
+    failed=1
+  fi
+  [ "$failed" = 0 ] || exit 1
 fi
 if [ "${AORTASPH_SKIP_TSAN:-0}" != 1 ]; then
   # Only the simulation-render pipeline test, built alone (sim + render + one test file): a few minutes.
   echo "== ThreadSanitizer build: simulation-render pipeline test (${SECONDS} s so far)"
-  cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=TSan -DCMAKE_CXX_FLAGS_TSAN="-O1 -g" -DAORTASPH_TSAN=ON > /dev/null
+  cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=TSan -DCMAKE_CXX_FLAGS_TSAN="-O1 -g1" -DAORTASPH_TSAN=ON > /dev/null
   cmake --build build-tsan --target aortasph_tsan_tests -j "$(nproc)"
   # LP_NUM_THREADS=0: llvmpipe draws on the render thread itself. Its own worker threads synchronise in ways
   # ThreadSanitizer cannot see (reports inside libOSMesa only); frames are identical either way (DESIGN.md).
   LP_NUM_THREADS=0 TSAN_OPTIONS=halt_on_error=1 ./build-tsan/tests/aortasph_tsan_tests
 fi
-if [ "${AORTASPH_SKIP_FUZZ:-0}" != 1 ]; then
+if [ "${AORTASPH_SKIP_FUZZ:-0}" != 1 ] && [ "$fuzzed" = 0 ]; then
   echo "== fuzzing the scene loader for ${AORTASPH_FUZZ_SECONDS:-60} s (libFuzzer, clang; ${SECONDS} s so far)"
   [ -x build-san/tests/aortasph_tests ] || sanitize_tree
-  scripts/fuzz.sh "${AORTASPH_FUZZ_SECONDS:-60}" build-san
+  fuzz_run
 fi
 echo "== release build: all tests (${SECONDS} s so far)"
 scripts/build.sh build
