@@ -443,9 +443,9 @@ TEST_CASE("non-reflecting outlet: a pressure pulse leaves the tube instead of ri
   double late_plain = 0.0, late_nr = 0.0;
   const double plain = ringing(0.0, &late_plain);
   const double nr = ringing(0.02, &late_nr);
-  INFO("rms of the inlet pressure over 24-80 ms: plain outlet " << plain << " Pa, non-reflecting " << nr
-                                                                 << " Pa; mean over 60-80 ms " << late_plain
-                                                                 << " / " << late_nr << " Pa");
+  INFO("rms of the inlet pressure over 24-80 ms: plain outlet "
+       << plain << " Pa, non-reflecting " << nr << " Pa; mean over 60-80 ms " << late_plain << " / "
+       << late_nr << " Pa");
   CHECK(plain > 10.0);      // the plain tube rings (a tenth of the pulse)
   CHECK(nr < 0.3 * plain);  // the treated outlet lets most of the wave out
   // and, once the wave has left, holds the prescribed pressure again (the column at rest at 200 Pa)

@@ -83,7 +83,9 @@ std::vector<double> OpenBoundaries::disc_velocities(const Particles& P) const {
           const double vw = P.m[i] / P.rho[i] * w * w;
           return UW{vw * P.v[i].dot(z.spec.normal), vw};
         },
-        [](const UW& a, const UW& b) { return UW{a.uw + b.uw, a.w + b.w}; });
+        [](const UW& a, const UW& b) {
+          return UW{a.uw + b.uw, a.w + b.w};
+        });
     u[k] = s.w > 0.0 ? s.uw / s.w : 0.0;
   }
   return u;
@@ -573,7 +575,8 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
       const FluidParams& fp = fluid_[z.material];
       const double s = z.spec.type == OpenBoundaryType::Outflow ? 1.0 : -1.0;
       OpenBoundaryFlow& f = flows_[k];
-      f.wave_p = std::exp(-dt / z.spec.non_reflecting_tau) * f.wave_p + s * fp.rho0 * fp.c0 * (u[k] - f.wave_ref);
+      f.wave_p =
+          std::exp(-dt / z.spec.non_reflecting_tau) * f.wave_p + s * fp.rho0 * fp.c0 * (u[k] - f.wave_ref);
       f.wave_ref = u[k];
     }
   }
