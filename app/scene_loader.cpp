@@ -836,7 +836,7 @@ class Loader {
     const std::string type = j.contains("type") && j["type"].is_string() ? j["type"].get<std::string>() : "";
     if (j.contains("type") && type != "inflow" && type != "outflow")
       fail(path + ".type", "unknown value " + j["type"].dump() + " (expected one of: inflow, outflow)");
-    std::vector<std::string> keys = {"name", "type", "point", "normal", "radius", "layers"};
+    std::vector<std::string> keys = {"name", "type", "point", "normal", "radius", "layers", "non_reflecting"};
     if (type == "inflow") keys.insert(keys.end(), {"body", "velocity", "profile", "pressure"});
     if (type == "outflow") keys.insert(keys.end(), {"pressure", "windkessel"});
     // An inflow is driven by a velocity or by a pressure, an outflow holds a pressure or a Windkessel: one
@@ -885,6 +885,11 @@ class Loader {
       b.windkessel = windkessel(o.raw("windkessel"), o.path("windkessel"));
     } else {
       b.pressure = series(o, "pressure", 0.0, false);
+    }
+    // The characteristic treatment (issue 17 item 3; open_boundary.hpp): only its relaxation time.
+    if (o.has("non_reflecting")) {
+      Obj nr(o.raw("non_reflecting"), o.path("non_reflecting"), {"relaxation_time"}, allowed);
+      b.non_reflecting_tau = nr.positive("relaxation_time");
     }
     return b;
   }

@@ -289,6 +289,9 @@ struct OpenBoundarySpec {
   // Outflow given `windkessel` instead of `pressure` (issue 17): the outlet pressure is the RCR model's
   // (sim/physiology/windkessel.hpp), driven by the flow out.
   std::optional<WindkesselParams> windkessel;
+  // `non_reflecting` (issue 17 item 3): relaxation time tau [s] of the characteristic (partially
+  // non-reflecting) treatment of open_boundary.hpp; 0: off (the plain Dirichlet condition, reflecting).
+  double non_reflecting_tau = 0.0;
 };
 
 struct Camera {

@@ -813,6 +813,12 @@ void World::save_state(StateWriter& out) const {
     for (double v :
          {f.flow, f.interval_volume, f.pressure, f.windkessel.pc, f.windkessel.q, f.windkessel.p_out})
       of.value(v);
+  if (open_.non_reflecting()) {  // the waves of non-reflecting boundaries: a section of its own (issue 17)
+    SectionWriter& ow = out.section("open_boundary_waves", 1);
+    ow.value(static_cast<uint64_t>(open_.flows().size()));
+    for (const OpenBoundaryFlow& f : open_.flows())
+      for (double v : {f.wave_ref, f.wave_p}) ow.value(v);
+  }
 
   // The Verlet lists are rebuilt from the positions of their last build (and the rebuild and sort schedule
   // continues from builds_), so the resumed run sees the very lists the saved one had.
@@ -904,6 +910,14 @@ void World::load_state(const StateReader& in) {
            {&f.flow, &f.interval_volume, &f.pressure, &f.windkessel.pc, &f.windkessel.q, &f.windkessel.p_out})
         *v = of.value<double>();
     of.done();
+  }
+  if (in.has("open_boundary_waves")) {
+    SectionReader ow = in.section("open_boundary_waves");
+    const auto nw = ow.value<uint64_t>();
+    if (nw != open_.flows().size()) ow.mismatch("open boundaries", nw, open_.flows().size());
+    for (OpenBoundaryFlow& f : open_.flows())
+      for (double* v : {&f.wave_ref, &f.wave_p}) *v = ow.value<double>();
+    ow.done();
   }
   if (in.has("shells") || !shells_.empty()) {
     SectionReader sh = in.section("shells");

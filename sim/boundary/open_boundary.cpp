@@ -61,6 +61,36 @@ std::vector<double> OpenBoundaries::measure_flows(const Particles& P) const {
   return q;
 }
 
+std::vector<double> OpenBoundaries::disc_velocities(const Particles& P) const {
+  // The volume-weighted mean of v . n over measure_flows()'s window: sum V (v . n) w / sum V w.
+  const std::size_t n = P.size();
+  const double L = support_, pi = 3.14159265358979323846;
+  std::vector<double> u(zones_.size(), 0.0);
+  for (std::size_t k = 0; k < zones_.size(); ++k) {
+    const Zone& z = zones_[k];
+    if (!(z.spec.non_reflecting_tau > 0.0) || !z.pressure_driven()) continue;
+    const double side = z.spec.type == OpenBoundaryType::Inflow ? 1.0 : -1.0;
+    struct UW {
+      double uw = 0.0, w = 0.0;
+    };
+    const UW s = parallel_reduce(
+        n, UW{},
+        [&](std::size_t i) {
+          if (P.kind[i] != Kind::Fluid) return UW{};
+          const double d = side * z.axial(P.x[i]);
+          if (d <= 0.0 || d >= L || z.radial(P.x[i]) >= z.spec.radius) return UW{};
+          const double w = std::sin(pi * d / L);
+          const double vw = P.m[i] / P.rho[i] * w * w;
+          return UW{vw * P.v[i].dot(z.spec.normal), vw};
+        },
+        [](const UW& a, const UW& b) {
+          return UW{a.uw + b.uw, a.w + b.w};
+        });
+    u[k] = s.w > 0.0 ? s.uw / s.w : 0.0;
+  }
+  return u;
+}
+
 double OpenBoundaries::Zone::inflow_speed(const Vec3& x, double t) const {
   const double V = spec.velocity.at(t);
   if (!spec.parabolic) return V;
@@ -94,6 +124,12 @@ void OpenBoundaries::configure(const Scene& scene, const std::vector<FluidParams
           throw SetupError(where(k, s) + ": the buffer (" + std::to_string(s.layers) +
                            " layers) reaches outside the domain");
       }
+    if (s.type == OpenBoundaryType::Outflow)  // the fluid that leaves: the first fluid body's material
+      for (const Body& b : scene.bodies)
+        if (scene.materials.at(b.material).type == MaterialType::Fluid) {
+          z.material = b.material;
+          break;
+        }
     if (s.type == OpenBoundaryType::Inflow) {
       if (s.body < 0 || s.body >= static_cast<int>(scene.bodies.size()) ||
           scene.materials.at(scene.bodies[s.body].material).type != MaterialType::Fluid)
@@ -203,6 +239,11 @@ void OpenBoundaries::setup(const Scene& scene, const std::vector<FluidParams>& f
     if (zones_[k].spec.windkessel) flows_[k].windkessel = windkessel_start(*zones_[k].spec.windkessel, q0[k]);
   }
   impose(P, scene.gravity, 0.0);
+  // Non-reflecting boundaries start without a wave, from the disc velocity or the slab pressure of t = 0.
+  const std::vector<double> u0 = disc_velocities(P);
+  for (std::size_t k = 0; k < zones_.size(); ++k)
+    if (zones_[k].spec.non_reflecting_tau > 0.0)
+      flows_[k].wave_ref = zones_[k].pressure_driven() ? u0[k] : flows_[k].pressure;
   for (std::size_t i = first_buffer; i < P.size(); ++i) {
     const Zone& z = zones_[zone_of(P.x[i], Kind::Inflow)];
     // A pressure inlet's buffer starts at rest; from the first step on it moves with the fluid at the disc.
@@ -250,6 +291,7 @@ void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) {
     const Zone& z = zones_[k];
     if (z.pressure_driven()) {
       outlet_p[k] = prescribed_pressure(k, t);
+      if (z.spec.non_reflecting_tau > 0.0) outlet_p[k] += flows_[k].wave_p;  // the outgoing wave's part
       flows_[k].pressure = outlet_p[k];
       continue;
     }
@@ -378,7 +420,12 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
           action[i] = kRemove;
         return;
       }
-      P.v[i] = z.inflow_speed(P.x[i], t_new) * z.spec.normal;
+      double speed = z.inflow_speed(P.x[i], t_new);
+      if (z.spec.non_reflecting_tau > 0.0) {  // the outgoing wave's velocity, u' = -p_w / (rho0 c0)
+        const FluidParams& fp = fluid_[z.material];
+        speed = std::max(speed - flows_[k].wave_p / (fp.rho0 * fp.c0), 0.0);
+      }
+      P.v[i] = speed * z.spec.normal;
       P.v_wall[i] = P.v[i];
       P.a[i] = Vec3::Zero();
       P.x[i] += dt * P.v[i];
@@ -518,7 +565,29 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
     f.interval_volume += q[k] * dt;
     if (zones_[k].spec.windkessel) windkessel_step(*zones_[k].spec.windkessel, f.windkessel, q[k], dt);
   }
+  // Non-reflecting boundaries (open_boundary.hpp): the wave parts advance over the step, pressure-driven ones
+  // with the disc velocity before their pressure is imposed, velocity inlets with the slab pressure after.
+  if (non_reflecting()) {
+    const std::vector<double> u = disc_velocities(P);
+    for (std::size_t k = 0; k < zones_.size(); ++k) {
+      const Zone& z = zones_[k];
+      if (!(z.spec.non_reflecting_tau > 0.0) || !z.pressure_driven()) continue;
+      const FluidParams& fp = fluid_[z.material];
+      const double s = z.spec.type == OpenBoundaryType::Outflow ? 1.0 : -1.0;
+      OpenBoundaryFlow& f = flows_[k];
+      f.wave_p =
+          std::exp(-dt / z.spec.non_reflecting_tau) * f.wave_p + s * fp.rho0 * fp.c0 * (u[k] - f.wave_ref);
+      f.wave_ref = u[k];
+    }
+  }
   impose(P, gravity, t_new);
+  for (std::size_t k = 0; k < zones_.size(); ++k) {
+    const Zone& z = zones_[k];
+    if (!(z.spec.non_reflecting_tau > 0.0) || z.pressure_driven()) continue;
+    OpenBoundaryFlow& f = flows_[k];
+    f.wave_p = std::exp(-dt / z.spec.non_reflecting_tau) * f.wave_p + (f.pressure - f.wave_ref);
+    f.wave_ref = f.pressure;
+  }
   return created > 0 || removed > 0;
 }
 

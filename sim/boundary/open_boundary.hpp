@@ -45,6 +45,22 @@
 //     particles enter and leave the slab with zero weight, so Q has no jumps when they do; integral of w over
 //     the slab: L / 2). Probes report its time average over the steps since the last output time (a multiple
 //     of time.output_interval).
+//   - Non-reflecting treatment (a boundary given `non_reflecting: {relaxation_time: tau}`, issue 17 item 3):
+//     the Dirichlet conditions above reflect every acoustic wave that reaches them (a prescribed pressure
+//     with inversion, a prescribed velocity like a rigid end), so the column between an inlet and an outlet
+//     rings at its organ-pipe frequencies. With the treatment, the boundary lets the outgoing plane wave
+//     (p' = rho0 c0 u'_n travelling out of the domain) pass and holds the prescribed value only on average,
+//     relaxing toward it with the time constant tau: the partially non-reflecting condition of Rudy &
+//     Strikwerda 1980 (J. Comput. Phys. 36:55) in the linearised characteristic (LODI) form of Poinsot & Lele
+//     1992 (J. Comput. Phys. 101:104, eq. 40 with K = 1 / tau). Pressure-driven boundaries impose
+//     p = p_target(t) + p_w, with dp_w/dt = s rho0 c0 du/dt - p_w / tau, u the mean normal velocity of the
+//     fluid in the slab next to the disc (the flow window below) and s = +1 at an outflow (normal out of the
+//     domain), -1 at a pressure inlet (normal into it); a velocity inlet imposes u_n = V(t) f(r) - p_w /
+//     (rho0 c0) (not below 0), with dp_w/dt = dp/dt - p_w / tau, p the inlet slab's mean pressure. For a wave
+//     of angular frequency omega the reflection coefficient is |R| = 1 / sqrt(1 + (2 omega tau)^2) (Selle,
+//     Nicoud & Poinsot 2004, AIAA J. 42:958): waves faster than 1 / (2 tau) leave, slower changes see the
+//     prescribed value. Each step p_w advances exactly for du (dp) constant over the step:
+//     p_w <- exp(-dt / tau) p_w + s rho0 c0 (u(t + dt) - u(t)).
 //
 // Every change of role, creation and removal is decided per particle and applied in one serial pass in index
 // order, new particles are appended in that order with ids from a counter: runs stay bitwise reproducible for
@@ -80,6 +96,10 @@ struct OpenBoundaryFlow {
   double interval_volume = 0.0;  // integral of Q dt since OpenBoundaries::interval_start() [m^3]
   double pressure = 0.0;         // the pressure it imposes now [Pa] (velocity inlet: the slab's mean)
   WindkesselState windkessel;    // Windkessel outlets only
+  // Non-reflecting boundaries only: the last measured disc velocity u (pressure-driven) or slab pressure p
+  // (velocity inlet), and the wave part p_w of the imposed pressure (velocity inlet: of the slab's pressure).
+  double wave_ref = 0.0;
+  double wave_p = 0.0;
 };
 
 class OpenBoundaries {
@@ -114,6 +134,12 @@ class OpenBoundaries {
   // Per boundary, in scene order (checkpoints restore them with interval_start()).
   const std::vector<OpenBoundaryFlow>& flows() const { return flows_; }
   std::vector<OpenBoundaryFlow>& flows() { return flows_; }
+  // Whether some boundary has the non-reflecting treatment (its wave state is then checkpointed).
+  bool non_reflecting() const {
+    for (const Zone& z : zones_)
+      if (z.spec.non_reflecting_tau > 0.0) return true;
+    return false;
+  }
   double interval_start() const { return interval_start_; }
   double& interval_start() { return interval_start_; }
   // Mean flow through boundary k over the steps since interval_start() up to time t (the last step's flow
@@ -130,7 +156,7 @@ class OpenBoundaries {
     double depth = 0.0;                       // layers * spacing
     double area = 0.0;                        // inflow: columns * spacing^2
     double profile_mean = 1.0;                // inflow: mean of 1 - r^2 / R^2 over the columns
-    int material = 0;                         // inflow: material of the fed body
+    int material = 0;                         // material of the fed body (outflow: the first fluid's)
     std::vector<Vec3> columns;                // inflow: lattice points of the columns on the disc
     // Coordinates of x relative to the disc: along the normal, and distance from the axis.
     double axial(const Vec3& x) const { return (x - spec.point).dot(spec.normal); }
@@ -151,6 +177,9 @@ class OpenBoundaries {
   std::vector<double> measure_flows(const Particles& P) const;
   // The prescribed pressure of a pressure inlet or an outflow at time t.
   double prescribed_pressure(std::size_t k, double t) const;
+  // Mean normal velocity of the fluid next to a pressure-driven non-reflecting boundary's disc (the flow
+  // window of measure_flows), per zone (0 for the others).
+  std::vector<double> disc_velocities(const Particles& P) const;
 
   std::vector<Zone> zones_;
   std::vector<FluidParams> fluid_;
