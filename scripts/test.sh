@@ -2,9 +2,10 @@
 # All tests: install, then a clang ASan+UBSan build runs the unit tests (left out: validation-size physics runs,
 # the aortic root in flow, [long] cases, runs of thousands of steps whose code paths shorter cases cover under
 # the sanitizers, and [heavy] cases: nine that took 10-30 s each there at stop 23 (136 s of the step's 298 s),
-# and four more at stop 24 (the RCR outlet's ODE run, the parabolic tube, the SIGKILL resume and the shell-contact
-# thread comparison: 208 of the step's 760 s on the loaded machine), each while other cases cover its code under the
-# sanitizers; they all run in the Release step), a ThreadSanitizer build runs the
+# and nine more at stop 24 (the RCR outlet's ODE run, the parabolic tube, the SIGKILL resume, the shell-contact
+# thread comparison, then the commissure posts 40 s, the fluid-and-block checkpoint 25 s, the mirror-leaflet
+# geometry 15 s and two shell-contact rests 14 and 13 s, measured on the quiet machine), each while other cases
+# cover its code under the sanitizers; they all run in the Release step), a ThreadSanitizer build runs the
 # simulation-render pipeline test, a bounded libFuzzer run fuzzes the scene loader (scripts/fuzz.sh, built in the
 # same clang sanitizer tree), then the Release build (GCC) runs every test through CTest.
 # AORTASPH_SKIP_SANITIZE=1, AORTASPH_SKIP_TSAN=1, AORTASPH_SKIP_FUZZ=1 leave a step out.
@@ -14,8 +15,11 @@ scripts/install-deps.sh --clang
 # One clang tree for the sanitizers and the fuzz target (-DAORTASPH_FUZZ=ON with AORTASPH_SANITIZE: the fuzz
 # target's own sources carry libFuzzer's coverage hooks): one build instead of two (2 min 55 s on 2 cores, stop
 # 14), and clang compiles faster than GCC here (solid_tlsph.cpp under ASan: 31 s of CPU against 44 s).
+# -g0: the sanitizers' reports name functions from the symbol table but give no file:line (rebuild with -g1 to
+# get them); line tables cost 17 % of the tree's compile time (test_aortic.cpp: 34.7 s of CPU with -g1, 28.8 s
+# without, stop 24). At -O0 the test files compile 2.5x faster but the cases ran 5-20x slower: tried, not used.
 sanitize_tree() {
-  scripts/build.sh build-san -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=ASan -DCMAKE_CXX_FLAGS_ASAN="-O1 -g1" \
+  scripts/build.sh build-san -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=ASan -DCMAKE_CXX_FLAGS_ASAN="-O1 -g0" \
     -DAORTASPH_SANITIZE=ON -DAORTASPH_FUZZ=ON
 }
 fuzz_run() { scripts/fuzz.sh "${AORTASPH_FUZZ_SECONDS:-60}" build-san; }
@@ -49,10 +53,15 @@ if [ "${AORTASPH_SKIP_SANITIZE:-0}" != 1 ]; then
     { ./build-san/tests/aortasph_tests --list-test-names-only -f /dev/stdin || true; } | awk 'NF' | wc -l)
   failed=0
   for k in 0 1; do
-    if wait "${pids[$k]}"; then tail -n 3 build-san/asan-shard$k.log; else cat build-san/asan-shard$k.log; failed=1; fi
+    if wait "${pids[$k]}"; then
+      echo "shard $k: $(grep -E '^(All tests passed|test cases)' build-san/asan-shard$k.log | tail -n 1)"
+    else
+      cat build-san/asan-shard$k.log
+      failed=1
+    fi
   done
   if [ "$fuzzed" = 1 ]; then
-    if wait "$fuzz_pid"; then tail -n 12 build-san/fuzz.log; else cat build-san/fuzz.log; failed=1; fi
+    if wait "$fuzz_pid"; then grep -E '^(Done|stat::)' build-san/fuzz.log; else cat build-san/fuzz.log; failed=1; fi
   fi
   if [ "$listed" != "$(wc -l < build-san/asan-cases.txt)" ]; then
     echo "the ASan shards hold $listed cases, the filter $(wc -l < build-san/asan-cases.txt)"

@@ -199,7 +199,7 @@ TEST_CASE("aortic root: a graft without sinuses and unequal commissures", "[aort
 }
 
 TEST_CASE("aortic root: mirror leaflets are the open leaflet reflected across a planar attachment",
-          "[aortic]") {
+          "[aortic][heavy]") {
   AorticRootParams p;
   p.mirror_leaflets = true;
   p.base = Vec3(0.01, -0.02, 0.005);

@@ -62,7 +62,7 @@ Scene fluid_and_block() {
 
 }  // namespace
 
-TEST_CASE("checkpoint: a loaded World continues bitwise as the saved one", "[checkpoint]") {
+TEST_CASE("checkpoint: a loaded World continues bitwise as the saved one", "[checkpoint][heavy]") {
   const Scene s = fluid_and_block();
   World a(s);
   for (int k = 0; k < 60; ++k) a.step(a.stable_dt());

@@ -77,7 +77,7 @@ void run(World& w, double t_end, const std::function<void()>& each) {
 }  // namespace
 
 TEST_CASE("shell contact: two plates pressed together rest at the contact distance and carry the load",
-          "[shell_contact]") {
+          "[shell_contact][heavy]") {
   // Two free 10 x 10 mm plates (t = 0.4 mm, dx = 1 mm), 1 mm apart, pressed together by 10 kPa each.
   Scene s = base_scene();
   s.materials = {sheet_material(kDamp)};
@@ -125,7 +125,7 @@ TEST_CASE("shell contact: two plates pressed together rest at the contact distan
   CHECK(std::abs(f.x()) + std::abs(f.y()) < 1e-3 * load);
 }
 
-TEST_CASE("shell contact: a plate pressed on a fixed wall rests above it", "[shell_contact]") {
+TEST_CASE("shell contact: a plate pressed on a fixed wall rests above it", "[shell_contact][heavy]") {
   Scene s = base_scene();
   s.materials = {sheet_material(3000.0), wall()};
   const double a = 10 * kDx;

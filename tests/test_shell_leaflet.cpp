@@ -203,7 +203,7 @@ TEST_CASE("shell leaflets: the blood stays half a spacing off the sheets, volume
 }
 
 TEST_CASE("shell leaflets: commissure posts clamp the leaflets there and leave no blood between them",
-          "[shell_leaflet]") {
+          "[shell_leaflet][heavy]") {
   const double dx = 0.001;
   AorticRootParams p = mirror();  // shell mirror leaflets: the post is on by default
   const double h = p.commissure_post_length();
