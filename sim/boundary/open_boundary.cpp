@@ -37,58 +37,37 @@ double OpenBoundaries::prescribed_pressure(std::size_t k, double t) const {
   return z.spec.pressure.at(t);
 }
 
-std::vector<double> OpenBoundaries::measure_flows(const Particles& P) const {
-  // Volume flux of the fluid in a slab one kernel support L deep on the domain's side of each disc, with the
-  // smooth window w(d) = sin^2(pi d / L) (open_boundary.hpp).
+std::vector<OpenBoundaries::SlabSums> OpenBoundaries::slab_sums(const Particles& P) const {
+  // The fluid in a slab one kernel support L deep on the domain's side of each disc, with the smooth window
+  // w(d) = sin^2(pi d / L) (open_boundary.hpp): sum V (v . n) w and sum V w, in one pass per zone.
   const std::size_t n = P.size();
   const double L = support_, pi = 3.14159265358979323846;
-  std::vector<double> q(zones_.size(), 0.0);
+  std::vector<SlabSums> out(zones_.size());
   for (std::size_t k = 0; k < zones_.size(); ++k) {
     const Zone& z = zones_[k];
     const double side = z.spec.type == OpenBoundaryType::Inflow ? 1.0 : -1.0;
-    const double sum = parallel_reduce(
-        n, 0.0,
+    out[k] = parallel_reduce(
+        n, SlabSums{},
         [&](std::size_t i) {
-          if (P.kind[i] != Kind::Fluid) return 0.0;
+          if (P.kind[i] != Kind::Fluid) return SlabSums{};
           const double d = side * z.axial(P.x[i]);
-          if (d <= 0.0 || d >= L || z.radial(P.x[i]) >= z.spec.radius) return 0.0;
+          if (d <= 0.0 || d >= L || z.radial(P.x[i]) >= z.spec.radius) return SlabSums{};
           const double w = std::sin(pi * d / L);
-          return P.m[i] / P.rho[i] * P.v[i].dot(z.spec.normal) * w * w;
+          return SlabSums{P.m[i] / P.rho[i] * P.v[i].dot(z.spec.normal) * w * w, P.m[i] / P.rho[i] * w * w};
         },
-        [](double a, double b) { return a + b; });
-    q[k] = sum / (0.5 * L);
+        [](const SlabSums& x, const SlabSums& y) {
+          return SlabSums{x.flux + y.flux, x.weight + y.weight};
+        });
   }
-  return q;
+  return out;
 }
 
-std::vector<double> OpenBoundaries::disc_velocities(const Particles& P) const {
-  // The volume-weighted mean of v . n over measure_flows()'s window: sum V (v . n) w / sum V w.
-  const std::size_t n = P.size();
-  const double L = support_, pi = 3.14159265358979323846;
-  std::vector<double> u(zones_.size(), 0.0);
-  for (std::size_t k = 0; k < zones_.size(); ++k) {
-    const Zone& z = zones_[k];
-    if (!(z.spec.non_reflecting_tau > 0.0) || !z.pressure_driven()) continue;
-    const double side = z.spec.type == OpenBoundaryType::Inflow ? 1.0 : -1.0;
-    struct UW {
-      double uw = 0.0, w = 0.0;
-    };
-    const UW s = parallel_reduce(
-        n, UW{},
-        [&](std::size_t i) {
-          if (P.kind[i] != Kind::Fluid) return UW{};
-          const double d = side * z.axial(P.x[i]);
-          if (d <= 0.0 || d >= L || z.radial(P.x[i]) >= z.spec.radius) return UW{};
-          const double w = std::sin(pi * d / L);
-          const double vw = P.m[i] / P.rho[i] * w * w;
-          return UW{vw * P.v[i].dot(z.spec.normal), vw};
-        },
-        [](const UW& a, const UW& b) {
-          return UW{a.uw + b.uw, a.w + b.w};
-        });
-    u[k] = s.w > 0.0 ? s.uw / s.w : 0.0;
-  }
-  return u;
+double OpenBoundaries::slab_flow(const SlabSums& s) const {
+  return s.flux / (0.5 * support_);  // the volume flux through the disc (open_boundary.hpp)
+}
+
+double OpenBoundaries::slab_velocity(const SlabSums& s) {
+  return s.weight > 0.0 ? s.flux / s.weight : 0.0;  // the window's volume-weighted mean of v . n
 }
 
 double OpenBoundaries::Zone::inflow_speed(const Vec3& x, double t) const {
@@ -233,17 +212,17 @@ void OpenBoundaries::setup(const Scene& scene, const std::vector<FluidParams>& f
   // The flows at t = 0 (the fluid's initial velocity) start the Windkessels.
   flows_.assign(zones_.size(), OpenBoundaryFlow{});
   interval_start_ = 0.0;
-  const std::vector<double> q0 = measure_flows(P);
+  const std::vector<SlabSums> s0 = slab_sums(P);
   for (std::size_t k = 0; k < zones_.size(); ++k) {
-    flows_[k].flow = q0[k];
-    if (zones_[k].spec.windkessel) flows_[k].windkessel = windkessel_start(*zones_[k].spec.windkessel, q0[k]);
+    const double q0 = slab_flow(s0[k]);
+    flows_[k].flow = q0;
+    if (zones_[k].spec.windkessel) flows_[k].windkessel = windkessel_start(*zones_[k].spec.windkessel, q0);
   }
   impose(P, scene.gravity, 0.0);
   // Non-reflecting boundaries start without a wave, from the disc velocity or the slab pressure of t = 0.
-  const std::vector<double> u0 = disc_velocities(P);
   for (std::size_t k = 0; k < zones_.size(); ++k)
     if (zones_[k].spec.non_reflecting_tau > 0.0)
-      flows_[k].wave_ref = zones_[k].pressure_driven() ? u0[k] : flows_[k].pressure;
+      flows_[k].wave_ref = zones_[k].pressure_driven() ? slab_velocity(s0[k]) : flows_[k].pressure;
   for (std::size_t i = first_buffer; i < P.size(); ++i) {
     const Zone& z = zones_[zone_of(P.x[i], Kind::Inflow)];
     // A pressure inlet's buffer starts at rest; from the first step on it moves with the fluid at the disc.
@@ -558,26 +537,27 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
   }
 
   // The flows of this step; the Windkessels advance with them to t_new.
-  const std::vector<double> q = measure_flows(P);
+  const std::vector<SlabSums> sums = slab_sums(P);
   for (std::size_t k = 0; k < zones_.size(); ++k) {
     OpenBoundaryFlow& f = flows_[k];
-    f.flow = q[k];
-    f.interval_volume += q[k] * dt;
-    if (zones_[k].spec.windkessel) windkessel_step(*zones_[k].spec.windkessel, f.windkessel, q[k], dt);
+    const double q = slab_flow(sums[k]);
+    f.flow = q;
+    f.interval_volume += q * dt;
+    if (zones_[k].spec.windkessel) windkessel_step(*zones_[k].spec.windkessel, f.windkessel, q, dt);
   }
   // Non-reflecting boundaries (open_boundary.hpp): the wave parts advance over the step, pressure-driven ones
   // with the disc velocity before their pressure is imposed, velocity inlets with the slab pressure after.
   if (non_reflecting()) {
-    const std::vector<double> u = disc_velocities(P);
     for (std::size_t k = 0; k < zones_.size(); ++k) {
       const Zone& z = zones_[k];
       if (!(z.spec.non_reflecting_tau > 0.0) || !z.pressure_driven()) continue;
       const FluidParams& fp = fluid_[z.material];
       const double s = z.spec.type == OpenBoundaryType::Outflow ? 1.0 : -1.0;
+      const double u = slab_velocity(sums[k]);
       OpenBoundaryFlow& f = flows_[k];
       f.wave_p =
-          std::exp(-dt / z.spec.non_reflecting_tau) * f.wave_p + s * fp.rho0 * fp.c0 * (u[k] - f.wave_ref);
-      f.wave_ref = u[k];
+          std::exp(-dt / z.spec.non_reflecting_tau) * f.wave_p + s * fp.rho0 * fp.c0 * (u - f.wave_ref);
+      f.wave_ref = u;
     }
   }
   impose(P, gravity, t_new);

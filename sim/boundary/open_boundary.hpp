@@ -173,13 +173,18 @@ class OpenBoundaries {
   int zone_of(const Vec3& x, Kind kind) const;
   // Pressure and density of every buffer particle at time t (records each boundary's pressure in flows_).
   void impose(Particles& P, const Vec3& gravity, double t);
-  // The flow through each boundary now (see above), per zone.
-  std::vector<double> measure_flows(const Particles& P) const;
+  // Per zone, the window sums of the slab next to its disc (see above): sum V (v . n) w and sum V w.
+  struct SlabSums {
+    double flux = 0.0, weight = 0.0;
+  };
+  std::vector<SlabSums> slab_sums(const Particles& P) const;
+  // The flow through a boundary (see above) from its slab sums.
+  double slab_flow(const SlabSums& s) const;
   // The prescribed pressure of a pressure inlet or an outflow at time t.
   double prescribed_pressure(std::size_t k, double t) const;
-  // Mean normal velocity of the fluid next to a pressure-driven non-reflecting boundary's disc (the flow
-  // window of measure_flows), per zone (0 for the others).
-  std::vector<double> disc_velocities(const Particles& P) const;
+  // Mean normal velocity of the fluid next to a disc (the window-weighted v . n; 0 in an empty window), used
+  // by the pressure-driven non-reflecting boundaries.
+  static double slab_velocity(const SlabSums& s);
 
   std::vector<Zone> zones_;
   std::vector<FluidParams> fluid_;
