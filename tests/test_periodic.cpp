@@ -127,45 +127,6 @@ TEST_CASE("a periodic run is bitwise identical for 1 and 2 threads", "[periodic]
   CHECK(hash[0] == hash[1]);
 }
 
-namespace {
-
-// The 2-D Taylor-Green vortex at Re = U lambda / nu = 100 in a periodic box lambda x lambda x 8 dx (periodic
-// in x, y and z): kinetic energy decays as exp(-4 nu k^2 t), k = 2 pi / lambda (2 nu k^2 t d with d = 2).
-struct TaylorGreen {
-  double lambda = 1.0, U = 1.0, nu = 0.01;
-  double decay_rate() const { return 4.0 * nu * std::pow(2.0 * M_PI / lambda, 2); }
-  Scene scene(int across, double c0, double pb, double delta, double shifting = 0.0) const {
-    const double dx = lambda / across, depth = 8 * dx;
-    Scene s;
-    s.name = "taylor_green";
-    s.spacing = dx;
-    s.gravity = Vec3::Zero();
-    s.domain = {Vec3(0, 0, 0), Vec3(lambda, lambda, depth)};
-    s.periodic = {true, true, true};
-    s.t_end = 1.0;
-    s.max_dt = 1e-2;
-    Material m = water(c0);
-    m.viscosity = nu;
-    m.background_pressure = pb;
-    m.delta_sph = delta;
-    m.shifting = shifting;
-    s.materials = {m};
-    Body b = box_body("fluid", 0, Vec3::Zero(), Vec3(lambda, lambda, depth));
-    b.taylor_green = InitialFlow{U, lambda};
-    s.bodies = {b};
-    return s;
-  }
-};
-
-double kinetic_energy(const World& w) {
-  const Particles& P = w.particles();
-  double e = 0;
-  for (std::size_t i = 0; i < P.size(); ++i) e += 0.5 * P.m[i] * P.v[i].squaredNorm();
-  return e;
-}
-
-}  // namespace
-
 TEST_CASE("Taylor-Green vortex at Re = 1: kinetic energy decays as exp(-4 nu k^2 t) within 5 %",
           "[periodic][fluid][validation]") {
   // U = 0.01 m/s, lambda = 1 m, nu = 0.01 m^2/s (Re = U lambda / nu = 1), c0 = 1 m/s (Mach 0.01), with its
