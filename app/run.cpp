@@ -706,7 +706,13 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
       static_cast<double>(world.memory_bytes()) / 1e6);
   if (scene.cycle) {
     std::string cols;
-    for (const auto& [key, col] : cycle_columns(scene)) cols += " " + key.substr(6) + "=" + col;
+    // Appended piecewise: " " + std::string trips GCC 12's -Wstringop-overflow false positive at -O3.
+    for (const auto& [key, col] : cycle_columns(scene)) {
+      cols += ' ';
+      cols.append(key, 6);
+      cols += '=';
+      cols += col;
+    }
     std::printf("  cycle: period %g s, %zu complete cycle(s) to t = %g s;%s\n", scene.cycle->period,
                 cycle_windows(scene.t_end, {scene.cycle->period, scene.cycle->start}).size(), scene.t_end,
                 cols.c_str());
