@@ -426,7 +426,8 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     if (!world.shells().empty())  // fluid particles put back on their side of a sheet (0 when it holds)
       j["shells"] = {{"particles", world.shells().size()},
                      {"fluid_crossings", world.shell_crossings()},
-                     {"masked_pairs", world.shell_masked_pairs()}};
+                     {"masked_pairs", world.shell_masked_pairs()},
+                     {"rim_particles", world.shell_rim_particles()}};
     j["timings_s"] = {{"setup", setup_seconds},
                       {"wall", std::chrono::duration<double>(Clock::now() - wall_start).count()}};
     for (const auto& [name, sec] : world.profile().phases()) j["timings_s"][name] = sec;

@@ -18,8 +18,12 @@ ShellCoupling::ShellCoupling(const Particles& P, const Shells& shells, double dx
   // every edge (only there is the exact patch test needed).
   const std::size_t n = shells.size();
   edge_.assign(n, 0);
+  rim_.assign(n, 0);
+  // The sheets' reference positions, then the wall particles (for the rim test below).
   std::vector<Vec3> X(n);
   for (std::size_t s = 0; s < n; ++s) X[s] = shells.reference(s);
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (P.kind[i] == Kind::Wall) X.push_back(P.x[i]);
   NeighborSearch nbs;
   nbs.build(X, support);
   const CubicSpline K(0.5 * support);
@@ -29,12 +33,28 @@ ShellCoupling::ShellCoupling(const Particles& P, const Shells& shells, double dx
     double sum = 0.0;
     for (uint32_t k = nbs.begin(s); k < nbs.end(s); ++k) {
       const uint32_t t = nbs.index()[k];
-      if (P.body[shells.at(t)] != body) continue;
+      if (t >= n || P.body[shells.at(t)] != body) continue;
       const double w = K.W((X[t] - X[s]).norm());
       moment += w * (X[t] - X[s]);
       sum += w;
     }
     edge_[s] = sum <= 0.0 || moment.norm() > 0.1 * dx * sum;
+    // The rim: the outermost row of an edge the fluid can pass round, i.e. edge particles with nothing
+    // beyond them along the outward direction -moment: no particle of their sheet farther out than dx / 2,
+    // and, for a particle held by a support, no wall particle within 1.5 dx and 45 degrees of it (an edge
+    // fixed into a wall is not a rim; a free edge that runs up to a commissure post is)
+    // (ShellWall::cap).
+    if (!edge_[s] || moment.norm() <= 0.0) return;
+    const Vec3 out = -moment.normalized();
+    const bool held = shells.support(s) != 0;
+    bool beyond = false;
+    for (uint32_t k = nbs.begin(s); k < nbs.end(s) && !beyond; ++k) {
+      const uint32_t t = nbs.index()[k];
+      const Vec3 d = X[t] - X[s];
+      beyond = t < n ? P.body[shells.at(t)] == body && d.dot(out) > 0.5 * dx
+                     : held && d.squaredNorm() < 2.25 * dx * dx && d.dot(out) > 0.7 * d.norm();
+    }
+    rim_[s] = !beyond;
   });
   // Their reference neighbours and weights, for the current outward direction (prepare()).
   edge_offset_.assign(1, 0);
@@ -43,7 +63,7 @@ ShellCoupling::ShellCoupling(const Particles& P, const Shells& shells, double dx
     const uint16_t body = P.body[shells.at(s)];
     for (uint32_t k = nbs.begin(s); k < nbs.end(s); ++k) {
       const uint32_t t = nbs.index()[k];
-      if (P.body[shells.at(t)] != body) continue;
+      if (t >= n || P.body[shells.at(t)] != body) continue;
       edge_nbr_.push_back(t);
       edge_w_.push_back(K.W((X[t] - X[s]).norm()));
     }
@@ -154,6 +174,9 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
     const double len = m.norm();
     if (len > 0.0) edge_out_[i] = -m / len;
   });
+  wall_.cap.assign(n, Vec3::Zero());
+  for (const uint32_t s : edge_slot_)
+    if (rim_[s]) wall_.cap[shells.at(s)] = edge_out_[shells.at(s)];
   // Rows as built, then the labels (also the imaginary particles' side for each fluid particle: outside the
   // band it has none).
   wall_.sides.assign(n, ShellWall::Sides{});

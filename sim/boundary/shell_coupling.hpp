@@ -60,6 +60,11 @@ class ShellCoupling {
   long crossings() const { return crossings_; }
   void set_crossings(long c) { crossings_ = c; }
   std::size_t masked_pairs() const { return masked_; }
+  std::size_t rim_particles() const {
+    std::size_t c = 0;
+    for (const uint8_t r : rim_) c += r;
+    return c;
+  }
 
  private:
   struct Label {
@@ -83,6 +88,7 @@ class ShellCoupling {
   bool active_ = false;
   double dx_ = 0.0, patch2_ = 0.0, ghost_rho_ = 1000.0;
   std::vector<uint8_t> edge_;  // by shell slot
+  std::vector<uint8_t> rim_;   // by shell slot: the outermost row of an edge (ShellWall::cap)
   // Edge particles (slots), their reference neighbours (slots) with kernel weights (CSR), and by particle
   // index the current outward in-plane direction of an edge particle (zero elsewhere).
   std::vector<uint32_t> edge_slot_, edge_offset_, edge_nbr_;
