@@ -151,7 +151,8 @@ class World {
   // The shells' own stable step (plate wave, shear-rotary, force limit): the sub-step bound.
   double shell_stable_dt() const;
   std::size_t shell_masked_pairs() const { return coupling_.masked_pairs(); }
-  // Shell particles on the rim of a free edge (the imaginary particles turn round it: fluid/shell_wall.hpp).
+  // Shell particles on the rim of a free edge (their imaginary particles slide over the half spacing beyond
+  // them: fluid/shell_wall.hpp).
   std::size_t shell_rim_particles() const { return coupling_.rim_particles(); }
   Shells& shells_for_test() { return shells_; }
   const CubicSpline& kernel() const { return kernel_; }

@@ -164,6 +164,7 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
   // Edge particles: the current outward direction in the tangent plane, minus the first moment of the
   // reference neighbours at their current positions.
   edge_out_.assign(n, Vec3::Zero());
+  wall_.cap.assign(n, Vec3::Zero());
   parallel_for(edge_slot_.size(), [&](std::size_t e) {
     const uint32_t i = shells.at(edge_slot_[e]);
     Vec3 m = Vec3::Zero();
@@ -173,10 +174,8 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
     m -= m.dot(nrm) * nrm;
     const double len = m.norm();
     if (len > 0.0) edge_out_[i] = -m / len;
+    if (rim_[edge_slot_[e]]) wall_.cap[i] = edge_out_[i];
   });
-  wall_.cap.assign(n, Vec3::Zero());
-  for (const uint32_t s : edge_slot_)
-    if (rim_[s]) wall_.cap[shells.at(s)] = edge_out_[shells.at(s)];
   // Rows as built, then the labels (also the imaginary particles' side for each fluid particle: outside the
   // band it has none).
   wall_.sides.assign(n, ShellWall::Sides{});
