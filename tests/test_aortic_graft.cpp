@@ -247,7 +247,7 @@ TEST_CASE("aortic graft: a neo-sinus graft bulges by neo_sinus_bulge mid-sinus",
 }
 
 TEST_CASE("aortic graft: a rotated commissure sits at the asked angle, sinus arcs 120 + d, 120 - d, 120",
-          "[aortic][graft]") {
+          "[aortic][graft][heavy]") {
   for (double delta : {20.0}) {
     for (bool in_graft : {false, true}) {
       AorticRootParams p = in_graft ? graft(0.026, AorticGraftShape::NeoSinus, 0.003) : AorticRootParams{};

@@ -321,11 +321,11 @@ void drop_block(double density) {
 }  // namespace
 
 // Two test cases (not one loop) so that CTest runs them side by side: each takes about 45 s.
-TEST_CASE("a dense block sinks through water, no fluid passes through it", "[rigid][fluid][validation]") {
+TEST_CASE("a dense block sinks through water, no fluid passes through it", "[rigid][fluid][.validation]") {
   drop_block(3000.0);
 }
 
-TEST_CASE("a light block floats on water, no fluid passes through it", "[rigid][fluid][validation]") {
+TEST_CASE("a light block floats on water, no fluid passes through it", "[rigid][fluid][.validation]") {
   drop_block(400.0);
 }
 

@@ -168,7 +168,7 @@ TEST_CASE("shell leaflets: one layer on the mid-surface, normals, areas and clam
 }
 
 TEST_CASE("shell leaflets: the blood stays half a spacing off the sheets, volumetric leaflets unchanged",
-          "[shell_leaflet]") {
+          "[shell_leaflet][heavy]") {
   const double dx = 0.001;
   AorticRootParams p = mirror();
   const ShapeSample blood = sample_aortic_root(p, AorticPart::Blood, 0, dx);

@@ -353,7 +353,7 @@ TEST_CASE("TL-SPH: a velocity pulse in a thin bar travels at sqrt(E/rho) and inv
 }
 
 TEST_CASE("TL-SPH cantilever without damping: energy within 1 % over 10 periods, no hourglass pattern",
-          "[solid][validation]") {
+          "[solid][.validation]") {
   // Issue 5, item 4. A clamped 0.1 x 0.02 x 0.02 m beam (4 layers) given its first-mode velocity profile,
   // artificial viscosity off, the default hourglass control on. Kinetic + elastic (with the hourglass
   // springs') energy must stay within 1 % for 10 periods. Two things broke this before: Ganzenmueller's
@@ -378,7 +378,7 @@ TEST_CASE("TL-SPH cantilever without damping: energy within 1 % over 10 periods,
 }
 
 TEST_CASE("TL-SPH cantilever: first-mode period within 5 % of Euler-Bernoulli, decay under 5 % per period",
-          "[solid][validation]") {
+          "[solid][.validation]") {
   // Issue 5, item 3. A clamped 0.2 m beam, 0.02 m deep in the plane of bending (L / H = 10: shear and rotary
   // inertia change the period by under 1 %) in 6 layers, 0.01 m wide in 3 (the width cancels from the
   // period), default damping, first-mode velocity profile with a 0.05 m/s tip.
@@ -406,7 +406,7 @@ TEST_CASE("TL-SPH cantilever: first-mode period within 5 % of Euler-Bernoulli, d
 
 TEST_CASE(
     "TL-SPH large deformation: a soft cantilever swings under gravity past 30 degrees, smooth and stable",
-    "[solid][validation]") {
+    "[solid][.validation]") {
   // Issue 5, item 5. A 0.2 m cantilever (2 x 2 cm, 4 layers) released straight under gravity; E = 0.65 MPa
   // puts the linear static tip rotation at 2 rho g L^3 / (E H^2) = 0.6 rad, so the first swing passes well
   // beyond 30 degrees. Throughout: no particle moves off its reference neighbours (every pair that started dx
@@ -644,7 +644,7 @@ TEST_CASE("TL-SPH in fluid: the fluid's background pressure does not squeeze a s
 TEST_CASE(
     "Flexible pole (paper Fig. 4): the impact wave reaches the fixed end at L / sqrt(E / rho), the hammer "
     "rebounds",
-    "[solid][scene][validation]") {
+    "[solid][scene][.validation]") {
   // Issue 5, item 6: scenes/flexible_pole.json as shipped, to 22 ms. The hammer's bottom row comes within one
   // spacing of the pole's top row (contact) at t = 2.5 ms. The compression pulse (several pole widths long,
   // so it travels at the bar speed sqrt(E / rho), not the P-wave speed) reaches the gauge above the clamp
