@@ -239,13 +239,14 @@ TEST_CASE(
 
 TEST_CASE(
     "Taylor-Green vortex at Re = 100, transport velocity with p_b = 2 rho0 c0^2 on a jittered lattice: KE "
-    "within 6.5 % over one decay time at lambda/10",
+    "within 6.5 % over half a decay time at lambda/10",
     "[periodic][fluid][validation][transport]") {
   // Issue 20's target (within 5 % of exp(-4 nu k^2 t) over T = 1 / (4 nu k^2)) is met at lambda/20 with the
   // background pressure doubled and the lattice jittered by 0.2 dx (bodies[].jitter): KE / exact within 2.9 %
-  // there (scripts/validate_taylor_green.sh; 0.99 at T), 6.1 % at lambda/10, which this test holds (lambda/20
-  // over T is 1.4 million particle-steps, too long for CTest). On the exact lattice the same run ends at
-  // 0.80 of the exact energy at lambda/20, with p_b = rho0 c0^2 and the jitter at 0.90 (docs/validation.md).
+  // there (scripts/validate_taylor_green.sh; 0.99 at T), 0.6 % at lambda/40, 6.1 % at lambda/10 (at 0.2 T;
+  // 1.006 at T). This test holds lambda/10 over the first half of T, where its worst error lies (lambda/20
+  // over T is 1.4 million particle-steps, too long for CTest). On the exact lattice the same run ends at 0.80
+  // of the exact energy at lambda/20, with p_b = rho0 c0^2 and the jitter at 0.90 (docs/validation.md).
   const TaylorGreen c;
   const double T = 1.0 / c.decay_rate();
   Scene s = transport_scene(c, 10, 10.0);
@@ -261,17 +262,17 @@ TEST_CASE(
   const Vec3 p0 = momentum();
   const double e0 = kinetic_energy(w);
   double worst = 0.0, last = 0.0, scale = 0.0;
-  for (int k = 1; k <= 10; ++k) {
+  for (int k = 1; k <= 5; ++k) {
     const double t = 0.1 * k * T;
     w.advance_to(t, [] { return true; });
     last = kinetic_energy(w) / e0 / std::exp(-c.decay_rate() * t);
     worst = std::max(worst, std::abs(last - 1.0));
   }
   for (std::size_t i = 0; i < P.size(); ++i) scale += P.m[i] * P.v[i].norm();
-  INFO("largest |KE / exact - 1| over T: " << worst << ", KE / exact at T: " << last);
+  INFO("largest |KE / exact - 1| over T / 2: " << worst << ", KE / exact at T / 2: " << last);
   CHECK(w.count(Kind::Fluid) == 800u);
-  CHECK(worst < 0.065);                // measured 0.061 (at 0.2 T)
-  CHECK(std::abs(last - 1.0) < 0.01);  // measured 1.006
+  CHECK(worst < 0.065);                 // measured 0.061 (at 0.2 T)
+  CHECK(std::abs(last - 1.0) < 0.015);  // measured 1.012 (the noise of the start has decayed)
   CHECK((momentum() - p0).norm() <= 1e-10 * scale);
 }
 
