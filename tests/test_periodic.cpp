@@ -203,9 +203,10 @@ TEST_CASE(
     "[periodic][fluid][validation][transport]") {
   // U = 1 m/s, lambda = 1 m, nu = 0.01 m^2/s (Re = 100), c0 = 10 m/s. Measured (stop 23, docs/validation.md):
   // KE / exact at 0.2 T = 0.127 s is 1.051 at lambda/10 and 1.013 at lambda/20 (plain WCSPH at lambda/20:
-  // 0.951). Issue 20's target, within 5 % over one decay time T, is MISSED: the vortex still breaks up
-  // between 0.2 T and 0.3 T with the formulation on (KE / exact 0.71 at 0.3 T at lambda/20), so the test
-  // holds it to what it reaches, the first fifth of T.
+  // 0.951). With Adami et al.'s p_b on the exact lattice issue 20's target, within 5 % over one decay time T,
+  // is missed: the vortex breaks up between 0.2 T and 0.3 T (KE / exact 0.71 at 0.3 T at lambda/20; the
+  // lattice strings out, docs/validation.md), so this test holds it to the first fifth of T. The set-up
+  // that meets the target (p_b = 2 rho0 c0^2, a jittered start) is the next test case.
   const TaylorGreen c;
   const double T = 1.0 / c.decay_rate();
   double error[2] = {0, 0};
