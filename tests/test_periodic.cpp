@@ -277,6 +277,47 @@ TEST_CASE(
   CHECK((momentum() - p0).norm() <= 1e-10 * scale);
 }
 
+TEST_CASE("a fluid body's jitter moves each particle off its site by at most jitter * dx per axis",
+          "[periodic][fluid][scene]") {
+  // bodies[].jitter (World::jitter_points): offsets within +-jitter dx along each axis, spread over that
+  // range, the same in two constructions, wrapped into the periodic box; the initial flow is the vortex at
+  // the moved positions.
+  const TaylorGreen c;
+  Scene s = c.scene(10, 10.0, 0.0, 0.0);
+  const World lattice(s);
+  s.bodies[0].jitter = 0.2;
+  const World a(s), b(s);
+  const Particles &L = lattice.particles(), &P = a.particles();
+  REQUIRE(P.size() == L.size());
+  const double dx = s.spacing, k = 2.0 * M_PI / c.lambda;
+  const Periodic per(s.domain, s.periodic);
+  std::vector<std::size_t> site(L.size());  // the lattice world's index of each particle id (both are sorted)
+  for (std::size_t i = 0; i < L.size(); ++i) site[L.id[i]] = i;
+  double largest = 0.0, smallest = 1.0, flow = 0.0;
+  Vec3 mean = Vec3::Zero();
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    const Vec3 d = per.image(P.x[i] - L.x[site[P.id[i]]]) / dx;
+    largest = std::max(largest, d.cwiseAbs().maxCoeff());
+    smallest = std::min(smallest, d.cwiseAbs().maxCoeff());
+    mean += d / static_cast<double>(P.size());
+    CHECK(P.x[i] == b.particles().x[i]);
+    for (int ax = 0; ax < 3; ++ax) {
+      CHECK(P.x[i][ax] >= s.domain.min[ax]);
+      CHECK(P.x[i][ax] < s.domain.max[ax]);
+    }
+    const double x = k * P.x[i].x(), y = k * P.x[i].y();
+    flow = std::max(flow,
+                    (P.v[i] - c.U * Vec3(std::sin(x) * std::cos(y), -std::cos(x) * std::sin(y), 0.0)).norm());
+  }
+  INFO("largest offset " << largest << " dx, smallest largest-axis offset " << smallest << " dx, mean "
+                         << mean.transpose());
+  CHECK(largest <= 0.2 + 1e-12);
+  CHECK(largest > 0.19);  // 2400 draws fill the range
+  CHECK(smallest < 0.1);
+  CHECK(mean.norm() < 0.02);
+  CHECK(flow < 1e-12);
+}
+
 TEST_CASE(
     "the transport velocity leaves a uniformly moving lattice undistorted and runs the same on 1 and 2 "
     "threads",
