@@ -569,7 +569,7 @@ class Loader {
   Body body(json& j, const std::string& path, const Scene& s) {
     Obj o(j, path,
           {"name", "material", "shape", "translate", "rotate", "velocity", "angular_velocity", "color",
-           "render", "fixed", "initial_flow", "pinned", "pressure_load", "slip"},
+           "render", "fixed", "initial_flow", "pinned", "pressure_load", "slip", "jitter"},
           allowed);
     Body b;
     b.name = o.string("name");
@@ -610,6 +610,14 @@ class Loader {
       Obj f(o.raw("initial_flow"), o.path("initial_flow"), {"taylor_green"}, allowed);
       Obj tg(f.raw("taylor_green"), f.path("taylor_green"), {"speed", "wavelength"}, allowed);
       b.taylor_green = InitialFlow{tg.number("speed"), tg.positive("wavelength")};
+    }
+    if (o.has("jitter")) {  // issue 20: a fluid body's particles off their lattice sites (docs/scenes.md)
+      if (s.materials[b.material].type != MaterialType::Fluid)
+        fail(o.path("jitter"), "only a fluid body takes a jitter");
+      b.jitter = o.number("jitter");
+      if (!(b.jitter >= 0.0 && b.jitter <= 0.25))
+        fail(o.path("jitter"),
+             "must lie in 0..0.25 (a fraction of the spacing), got " + json(b.jitter).dump());
     }
     if (o.has("color")) b.color = o.color("color");
     const std::string mode = o.choice("render", {"particles", "surface", "hidden"}, "particles");

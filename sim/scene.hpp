@@ -203,6 +203,10 @@ struct Body {
   RenderMode render = RenderMode::Particles;
   std::optional<Box> fixed;                 // elastic bodies: particles inside are clamped
   std::optional<InitialFlow> taylor_green;  // fluid bodies: initial_flow.taylor_green
+  // Fluid bodies, `jitter` (issue 20): each particle moved from its lattice site by up to jitter * spacing
+  // along each axis (0: off, the exact lattice), a fixed pseudo-random offset (World's constructor), so that
+  // the lattice's mirror symmetry does not outlive the start (docs/model.md, transport velocity).
+  double jitter = 0.0;
   // Shell bodies: supports (each a list of boxes): fixed holds position and director, pinned the position.
   std::vector<Box> shell_fixed, shell_pinned;
   std::optional<TimeSeries> pressure_load;  // shell bodies: pressure along the normal [Pa]

@@ -62,6 +62,24 @@ Kind kind_of(MaterialType t) {
 
 }  // namespace
 
+// Body::jitter: each point of body b moved by up to `amplitude` along each axis, by an offset that depends
+// only on (b, point index, axis) (SplitMix64, Steele, Lea & Flood 2014, as a counter-based generator): the
+// same on every machine and for any thread count. Out through a periodic face, in through the other.
+void World::jitter_points(std::vector<Vec3>& points, std::size_t b, double amplitude) const {
+  auto uniform = [](uint64_t n) {  // in [-1, 1)
+    uint64_t z = n + 0x9e3779b97f4a7c15ULL;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    z ^= z >> 31;
+    return static_cast<double>(z >> 11) * 0x1.0p-52 - 1.0;
+  };
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const uint64_t n = (static_cast<uint64_t>(b) << 40) + 3 * static_cast<uint64_t>(k);
+    points[k] += amplitude * Vec3(uniform(n), uniform(n + 1), uniform(n + 2));
+    if (ctx_.periodic.any) ctx_.periodic.wrap(points[k]);
+  }
+}
+
 World::World(const Scene& scene)
     : scene_(scene),
       kernel_(scene.smoothing_ratio * scene.spacing),
@@ -96,6 +114,8 @@ World::World(const Scene& scene)
     ShapeSample sample = sample_body(body, dx);
     if (sample.points.empty())
       throw SetupError(where + ": the shape holds no particle at spacing " + std::to_string(dx));
+    if (body.jitter > 0.0 && mat.type == MaterialType::Fluid)
+      jitter_points(sample.points, b, body.jitter * dx);
     if (scene_.bodies.size() > std::numeric_limits<uint16_t>::max())
       throw SetupError("bodies: too many bodies");
 

@@ -257,6 +257,7 @@ class World {
   std::vector<Vec3> x_at_build_;
   std::vector<uint32_t> skin_index_;
   void record_build_positions(const std::vector<Vec3>& x);
+  void jitter_points(std::vector<Vec3>& points, std::size_t b, double amplitude) const;  // Body::jitter
   std::vector<Vec3> build_positions() const;  // every particle's, walls included
 };
 

@@ -203,9 +203,10 @@ TEST_CASE(
     "[periodic][fluid][validation][transport]") {
   // U = 1 m/s, lambda = 1 m, nu = 0.01 m^2/s (Re = 100), c0 = 10 m/s. Measured (stop 23, docs/validation.md):
   // KE / exact at 0.2 T = 0.127 s is 1.051 at lambda/10 and 1.013 at lambda/20 (plain WCSPH at lambda/20:
-  // 0.951). Issue 20's target, within 5 % over one decay time T, is MISSED: the vortex still breaks up
-  // between 0.2 T and 0.3 T with the formulation on (KE / exact 0.71 at 0.3 T at lambda/20), so the test
-  // holds it to what it reaches, the first fifth of T.
+  // 0.951). With Adami et al.'s p_b on the exact lattice issue 20's target, within 5 % over one decay time T,
+  // is missed: the vortex breaks up between 0.2 T and 0.3 T (KE / exact 0.71 at 0.3 T at lambda/20; the
+  // lattice strings out, docs/validation.md), so this test holds it to the first fifth of T. The set-up
+  // that meets the target (p_b = 2 rho0 c0^2, a jittered start) is the next test case.
   const TaylorGreen c;
   const double T = 1.0 / c.decay_rate();
   double error[2] = {0, 0};
@@ -235,6 +236,86 @@ TEST_CASE(
                                                << " at lambda/20");
   CHECK(error[1] < 0.02);
   CHECK(error[0] / error[1] > 2.5);  // about second order (measured 3.8)
+}
+
+TEST_CASE(
+    "Taylor-Green vortex at Re = 100, transport velocity with p_b = 2 rho0 c0^2 on a jittered lattice: KE "
+    "within 6.5 % over half a decay time at lambda/10",
+    "[periodic][fluid][validation][transport]") {
+  // Issue 20's target (within 5 % of exp(-4 nu k^2 t) over T = 1 / (4 nu k^2)) is met at lambda/20 with the
+  // background pressure doubled and the lattice jittered by 0.2 dx (bodies[].jitter): KE / exact within 2.9 %
+  // there (scripts/validate_taylor_green.sh; 0.99 at T), 0.6 % at lambda/40, 6.1 % at lambda/10 (at 0.2 T;
+  // 1.006 at T). This test holds lambda/10 over the first half of T, where its worst error lies (lambda/20
+  // over T is 1.4 million particle-steps, too long for CTest). On the exact lattice the same run ends at 0.80
+  // of the exact energy at lambda/20, with p_b = rho0 c0^2 and the jitter at 0.90 (docs/validation.md).
+  const TaylorGreen c;
+  const double T = 1.0 / c.decay_rate();
+  Scene s = transport_scene(c, 10, 10.0);
+  s.materials[0].transport_velocity_pb = 2.0 * s.materials[0].density * 10.0 * 10.0;
+  s.bodies[0].jitter = 0.2;
+  World w(s);
+  const Particles& P = w.particles();
+  auto momentum = [&] {
+    Vec3 p = Vec3::Zero();
+    for (std::size_t i = 0; i < P.size(); ++i) p += P.m[i] * P.v[i];
+    return p;
+  };
+  const Vec3 p0 = momentum();
+  const double e0 = kinetic_energy(w);
+  double worst = 0.0, last = 0.0, scale = 0.0;
+  for (int k = 1; k <= 5; ++k) {
+    const double t = 0.1 * k * T;
+    w.advance_to(t, [] { return true; });
+    last = kinetic_energy(w) / e0 / std::exp(-c.decay_rate() * t);
+    worst = std::max(worst, std::abs(last - 1.0));
+  }
+  for (std::size_t i = 0; i < P.size(); ++i) scale += P.m[i] * P.v[i].norm();
+  INFO("largest |KE / exact - 1| over T / 2: " << worst << ", KE / exact at T / 2: " << last);
+  CHECK(w.count(Kind::Fluid) == 800u);
+  CHECK(worst < 0.065);                 // measured 0.061 (at 0.2 T)
+  CHECK(std::abs(last - 1.0) < 0.015);  // measured 1.012 (the noise of the start has decayed)
+  CHECK((momentum() - p0).norm() <= 1e-10 * scale);
+}
+
+TEST_CASE("a fluid body's jitter moves each particle off its site by at most jitter * dx per axis",
+          "[periodic][fluid][scene]") {
+  // bodies[].jitter (World::jitter_points): offsets within +-jitter dx along each axis, spread over that
+  // range, the same in two constructions, wrapped into the periodic box; the initial flow is the vortex at
+  // the moved positions.
+  const TaylorGreen c;
+  Scene s = c.scene(10, 10.0, 0.0, 0.0);
+  const World lattice(s);
+  s.bodies[0].jitter = 0.2;
+  const World a(s), b(s);
+  const Particles &L = lattice.particles(), &P = a.particles();
+  REQUIRE(P.size() == L.size());
+  const double dx = s.spacing, k = 2.0 * M_PI / c.lambda;
+  const Periodic per(s.domain, s.periodic);
+  std::vector<std::size_t> site(L.size());  // the lattice world's index of each particle id (both are sorted)
+  for (std::size_t i = 0; i < L.size(); ++i) site[L.id[i]] = i;
+  double largest = 0.0, smallest = 1.0, flow = 0.0;
+  Vec3 mean = Vec3::Zero();
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    const Vec3 d = per.image(P.x[i] - L.x[site[P.id[i]]]) / dx;
+    largest = std::max(largest, d.cwiseAbs().maxCoeff());
+    smallest = std::min(smallest, d.cwiseAbs().maxCoeff());
+    mean += d / static_cast<double>(P.size());
+    CHECK(P.x[i] == b.particles().x[i]);
+    for (int ax = 0; ax < 3; ++ax) {
+      CHECK(P.x[i][ax] >= s.domain.min[ax]);
+      CHECK(P.x[i][ax] < s.domain.max[ax]);
+    }
+    const double x = k * P.x[i].x(), y = k * P.x[i].y();
+    flow = std::max(flow,
+                    (P.v[i] - c.U * Vec3(std::sin(x) * std::cos(y), -std::cos(x) * std::sin(y), 0.0)).norm());
+  }
+  INFO("largest offset " << largest << " dx, smallest largest-axis offset " << smallest << " dx, mean "
+                         << mean.transpose());
+  CHECK(largest <= 0.2 + 1e-12);
+  CHECK(largest > 0.19);  // 2400 draws fill the range
+  CHECK(smallest < 0.1);
+  CHECK(mean.norm() < 0.02);
+  CHECK(flow < 1e-12);
 }
 
 TEST_CASE(

@@ -2,9 +2,11 @@
 // Re = U lambda / nu = 100 (U = 1 m/s, lambda = 1 m, nu = 0.01 m^2/s) in a periodic box lambda x lambda x
 // 8 dx; prints KE / exp(-4 nu k^2 t) at every tenth of the decay time T, the closest pair over dx, the
 // largest speed, and the cost. Parameters from the environment: N (lambda/dx, 20), C0 (10), PB (the
-// transport velocity's background pressure, 1e5 = rho0 c0^2; 0: off), GAMMA (1), SUMM (density summation,
-// 1), DELTA (delta-SPH, 0.1, with SUMM=0 only), SHIFT (shifting A, 0), SR (h / dx, 1.3), KMAX (tenths of T,
-// 10).
+// transport velocity's background pressure, 2e5 = 2 rho0 c0^2; 0: off), JITTER (bodies[].jitter, 0.2 of
+// dx; 0: the exact lattice), GAMMA (1), SUMM (density summation, 1), DELTA (delta-SPH, 0.1, with SUMM=0
+// only), SHIFT (shifting A, 0), SR (h / dx, 1.3), KMAX (tenths of T, 10), NU (kinematic viscosity, 0.01:
+// Re = 100; the decay time T = 1 / (4 nu k^2) follows it). The defaults are the set-up that meets issue
+// 20's target at lambda/20 (docs/validation.md).
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
@@ -25,8 +27,8 @@ static double envd(const char* k, double d) {
 TEST_CASE("Taylor-Green vortex at Re = 100, long run (scripts/validate_taylor_green.sh)",
           "[.][taylor-green-validate]") {
   const int across = static_cast<int>(envd("N", 20));
-  const double c0 = envd("C0", 10), pb = envd("PB", 1e5), gamma = envd("GAMMA", 1), nu = 0.01, U = 1,
-               lambda = 1, delta = envd("DELTA", 0.1), shifting = envd("SHIFT", 0), sr = envd("SR", 0);
+  const double c0 = envd("C0", 10), pb = envd("PB", 2e5), gamma = envd("GAMMA", 1), nu = envd("NU", 0.01),
+               U = 1, lambda = 1, delta = envd("DELTA", 0.1), shifting = envd("SHIFT", 0), sr = envd("SR", 0);
   const bool summ = envd("SUMM", 1) > 0;
   const double dx = lambda / across;
   TaylorGreen c;
@@ -39,6 +41,7 @@ TEST_CASE("Taylor-Green vortex at Re = 100, long run (scripts/validate_taylor_gr
   m.eos_exponent = gamma;
   m.density_summation = summ;
   m.transport_velocity_pb = pb;
+  s.bodies[0].jitter = envd("JITTER", 0.2);
   World w(s);
   auto ke = [&] { return kinetic_energy(w); };
   const double rate = 4 * nu * std::pow(2 * M_PI / lambda, 2), T = 1 / rate;

@@ -1,6 +1,13 @@
 // Transport-velocity formulation for the fluid (issue 20): Adami, Hu & Adams 2013, "A transport-velocity
 // formulation for smoothed particle hydrodynamics", J. Comput. Phys. 241:292-307.
-// (The section numbers below are as recalled; the paper's text was not at hand when this was written.)
+// (The paper's text was not at hand. Its equation numbers, as PySPH's implementation cites them: eq. (13)
+// the background-pressure acceleration a_b below, eqs. (14)-(16) the velocity-Verlet steps with
+// v~(t + dt/2) = v(t + dt/2) + (dt/2) a_b, eq. (8) the momentum equation with A, eq. (7) the
+// inter-particle-averaged pressure that the force here replaces by the symmetric form of eq. (9) of the
+// project's paper; an independent 2-D implementation with eq. (7) and the paper's quintic kernel gives the
+// same Taylor-Green energy history, docs/validation.md.) On an exact lattice the sum below is zero on any
+// uniformly strained patch (mirror symmetry), so a_b cannot keep a strained lattice isotropic: start such
+// flows from a jittered lattice (Body::jitter).
 //
 // Particles are advected with a transport velocity v~ that differs from their momentum velocity v by the
 // acceleration of a constant background pressure p_b, which pushes them from where they crowd to where they
