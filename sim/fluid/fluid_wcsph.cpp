@@ -6,6 +6,37 @@
 
 namespace aortasph {
 
+namespace {
+
+// The shell terms of the density loops (fluid/shell_wall.hpp), out of line: only scenes with a shell beside
+// a fluid reach them, and inlined they made the loops of every scene slower (docs/performance.md, issue 18).
+// Each adds its imaginary particles' terms to `sum` one by one, in the order of for_each_ghost.
+
+// eq. (11) for the imaginary wall particles of shell particle j.
+[[gnu::noinline]] void shell_density(const Particles& P, const FluidContext& ctx, std::size_t i, uint32_t j,
+                                     const Vec3& xij, double& sum) {
+  const ShellWall& sw = *ctx.shell_wall;
+  sw.for_each_ghost(xij, i, j, P.body[j],
+                    [&](const Vec3& r) { sum += sw.ghost_mass[j] * ctx.kernel.W(r.norm()); });
+}
+
+// Continuity, eq. (12), for the imaginary wall particles of shell particle j, which move with the shell.
+[[gnu::noinline]] void shell_density_rate(const Particles& P, const FluidContext& ctx, std::size_t i,
+                                          uint32_t j, const Vec3& xij, const Vec3& vi, double& drho) {
+  const ShellWall& sw = *ctx.shell_wall;
+  const CubicSpline& K = ctx.kernel;
+  const double support2 = K.support * K.support;
+  const Vec3 vij = vi - P.v[j];
+  sw.for_each_ghost(xij, i, j, P.body[j], [&](const Vec3& rg) {
+    const double rg2 = rg.squaredNorm();
+    if (rg2 >= support2) return;
+    const double rr = std::sqrt(rg2);
+    drho += sw.ghost_mass[j] * (K.dWdr(rr) / rr) * vij.dot(rg);
+  });
+}
+
+}  // namespace
+
 void fluid_density_summation(Particles& P, const NeighborSearch& nb, const FluidContext& ctx) {
   const auto& idx = nb.index();
   const double w0 = ctx.kernel.W(0.0);
@@ -14,13 +45,13 @@ void fluid_density_summation(Particles& P, const NeighborSearch& nb, const Fluid
     // eq. (11): rho_i = sum_j m_j W_ij, self term included. Boundary particles carry the mass of the fluid
     // they stand in for, which keeps the sum complete next to walls.
     double rho = P.m[i] * w0;
-    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
+    const ShellWall* sw = ctx.shell_wall;
+    const uint32_t end = nb.end(i);
+    for (uint32_t k = nb.begin(i); k < end; ++k) {
       const uint32_t j = idx[k];
       const Vec3 xij = ctx.separation(P.x[i], P.x[j]);
-      if (ctx.shell_wall && P.kind[j] == Kind::Shell) {  // the shell's imaginary wall particles
-        const ShellWall& sw = *ctx.shell_wall;
-        sw.for_each_ghost(xij, i, j, P.body[j],
-                          [&](const Vec3& r) { rho += sw.ghost_mass[j] * ctx.kernel.W(r.norm()); });
+      if (sw && P.kind[j] == Kind::Shell) {  // the shell's imaginary wall particles
+        shell_density(P, ctx, i, j, xij, rho);
         continue;
       }
       rho += P.m[j] * ctx.kernel.W(xij.norm());
@@ -59,21 +90,15 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
     const double diffusion = 2.0 * fi.delta * h * fi.c0;
     const double inv_c2 = 1.0 / (fi.c0 * fi.c0);
     double drho = 0.0;
-    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
+    const ShellWall* sw = ctx.shell_wall;
+    const uint32_t end = nb.end(i);
+    for (uint32_t k = nb.begin(i); k < end; ++k) {
       const uint32_t j = idx[k];
       const Vec3 xij = ctx.separation(xi, P.x[j]);
       const double r2 = xij.squaredNorm();
       if (r2 >= support2 || r2 <= 0.0) continue;  // Verlet-list pairs in the skin: the kernel is zero there
-      if (ctx.shell_wall && P.kind[j] == Kind::Shell) {
-        // The shell's imaginary wall particles move with the shell (fluid/shell_wall.hpp).
-        const ShellWall& sw = *ctx.shell_wall;
-        const Vec3 vij = vi - P.v[j];
-        sw.for_each_ghost(xij, i, j, P.body[j], [&](const Vec3& rg) {
-          const double rg2 = rg.squaredNorm();
-          if (rg2 >= support2) return;
-          const double rr = std::sqrt(rg2);
-          drho += sw.ghost_mass[j] * (K.dWdr(rr) / rr) * vij.dot(rg);
-        });
+      if (sw && P.kind[j] == Kind::Shell) {
+        shell_density_rate(P, ctx, i, j, xij, vi, drho);
         continue;
       }
       const double r = std::sqrt(r2);
@@ -149,9 +174,9 @@ inline Vec3 local_wall_term(const FluidContext& ctx, const PairConstants& c, con
 }
 
 // Acceleration of fluid particle i due to the imaginary wall particles of shell particle j
-// (fluid/shell_wall.hpp), each a local wall.
-inline Vec3 shell_acceleration(const Particles& P, const FluidContext& ctx, const PairConstants& c,
-                               const FluidI& I, std::size_t j, const Vec3& xij, Vec3* background) {
+// (fluid/shell_wall.hpp), each a local wall. Out of line, as the shell terms of the density loops.
+[[gnu::noinline]] Vec3 shell_acceleration(const Particles& P, const FluidContext& ctx, const PairConstants& c,
+                                          const FluidI& I, std::size_t j, const Vec3& xij, Vec3* background) {
   const ShellWall& sw = *ctx.shell_wall;
   const double mg = sw.ghost_mass[j];
   const Vec3 vij = I.v - P.v[j];
@@ -163,8 +188,20 @@ inline Vec3 shell_acceleration(const Particles& P, const FluidContext& ctx, cons
   return acc;
 }
 
-inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx, const PairConstants& c,
-                              const FluidI& I, std::size_t j, Vec3* background = nullptr) {
+// The transport-velocity term of pair_acceleration (see there), out of line: only scenes with the
+// formulation on reach it.
+[[gnu::noinline]] Vec3 transport_stress(const Particles& P, const FluidContext& ctx, const FluidI& I,
+                                        std::size_t j, const Vec3& gradW, double mj, double rhoj) {
+  Vec3 stress = (ctx.transport_dv[I.i].dot(gradW) / I.rho) * I.v;
+  if (P.kind[j] == Kind::Fluid) stress += (ctx.transport_dv[j].dot(gradW) / rhoj) * P.v[j];
+  return mj * stress;
+}
+
+// Inlined into the pair loops: out of line (GCC's choice once the shell and transport-velocity terms were
+// added) the force loop of the aortic bench took about 15 % longer (docs/performance.md, issue 18).
+[[gnu::always_inline]] inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx,
+                                                     const PairConstants& c, const FluidI& I, std::size_t j,
+                                                     Vec3* background = nullptr) {
   const Vec3 xij = ctx.separation(I.x, P.x[j]);
   const double r2 = xij.squaredNorm();
   if (r2 >= c.support2 || r2 <= 0.0) return Vec3::Zero();  // Verlet-list pairs in the skin
@@ -216,11 +253,7 @@ inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx, const
   // A, here in the symmetric form of the pressure term, m_j (A_i / rho_i^2 + A_j / rho_j^2) . grad W, with A
   // . grad W = rho v ((v~ - v) . grad W). A is zero for boundary particles (they move with their own
   // velocity) and for fluid without the formulation (its v~ - v is zero).
-  if (!ctx.transport_dv.empty()) {
-    Vec3 stress = (ctx.transport_dv[I.i].dot(gradW) / rhoi) * I.v;
-    if (P.kind[j] == Kind::Fluid) stress += (ctx.transport_dv[j].dot(gradW) / rhoj) * P.v[j];
-    acc += mj * stress;
-  }
+  if (!ctx.transport_dv.empty()) acc += transport_stress(P, ctx, I, j, gradW, mj, rhoj);
   return acc;
 }
 
