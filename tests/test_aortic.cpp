@@ -556,7 +556,8 @@ TEST_CASE("aortic root scenes: impossible geometry is refused naming the paramet
   CHECK_THAT(load_error(typo), Catch::Contains("aortic_root.annulus_raduis: unknown key"));
 }
 
-TEST_CASE("aortic root scenes: aortasph check builds the world, bad geometry exits 2", "[aortic][scene][heavy]") {
+TEST_CASE("aortic root scenes: aortasph check builds the world, bad geometry exits 2",
+          "[aortic][scene][heavy]") {
   const std::string scene = std::string(AORTASPH_TEST_DIR) + "/data/aortic_root_geometry.json";
   const std::string bin = AORTASPH_BINARY;
   auto run = [&](const std::string& args) {
