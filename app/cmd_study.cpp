@@ -73,6 +73,7 @@ struct Study {
   int threads = 1;
   double checkpoint_every = 0.0;  // 0: a tenth of the run
   bool render = false;
+  int vtk_every = 0;  // 0: no VTK frames; N: `aortasph run --vtk-every N` (the stress maps read the last)
   json report;
 };
 
@@ -213,7 +214,7 @@ Study read_study(const fs::path& file) {
   }
   if (j.contains("run")) {
     const json& r = j["run"];
-    check_keys(s, r, "run", {"threads", "checkpoint_every", "render"});
+    check_keys(s, r, "run", {"threads", "checkpoint_every", "render", "vtk"});
     if (r.contains("threads")) {
       if (!r["threads"].is_number_integer() || r["threads"].get<int>() < 1)
         fail(s, "run.threads", "expected an integer >= 1");
@@ -226,6 +227,15 @@ Study read_study(const fs::path& file) {
     if (r.contains("render")) {
       if (!r["render"].is_boolean()) fail(s, "run.render", "expected true or false");
       s.render = r["render"].get<bool>();
+    }
+    if (r.contains("vtk")) {  // true: every output; N: every N-th output and the last
+      const json& v = r["vtk"];
+      if (v.is_boolean())
+        s.vtk_every = v.get<bool>() ? 1 : 0;
+      else if (v.is_number_integer() && v.get<long>() >= 1 && v.get<long>() <= 1000000)
+        s.vtk_every = static_cast<int>(v.get<long>());
+      else
+        fail(s, "run.vtk", "expected true, false or a whole number of outputs >= 1, got " + v.dump());
     }
   }
   s.report = j.value("report", json::object());
@@ -409,6 +419,7 @@ std::string snakefile(const Study& s, const std::vector<Variant>& variants, doub
     << "CHECKPOINT_EVERY = " << json(checkpoint_every).dump() << "\n"
     << "PYTHON = " << py_str(report_python()) << "\n"
     << "RENDER = " << (s.render ? "True" : "False") << "\n"
+    << "VTK_EVERY = " << s.vtk_every << "  # 0: no VTK frames\n"
     << "# variant id -> its --set KEY=VALUE list (fixed sets first); variants.csv has the values\n"
     << "VARIANTS = {\n";
   for (const auto& v : variants) {
@@ -447,6 +458,8 @@ def variant_job(vid, threads, log):
         cmd += ["--out", d, "--threads", str(threads), "--checkpoint-every", str(CHECKPOINT_EVERY), "--quiet"]
         if not RENDER:
             cmd.append("--no-render")
+        if VTK_EVERY > 0:
+            cmd += ["--vtk-every", str(VTK_EVERY)]
     with open(log, "w") as out:  # the run's output goes to the variant's log
         rc = subprocess.run(cmd, stdout=out, stderr=subprocess.STDOUT, check=False).returncode
     run = read_json(d + "/run.json") or {}

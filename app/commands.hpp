@@ -16,6 +16,7 @@ struct RunOptions {
   std::vector<std::string> sets;  // --set KEY=VALUE
   bool no_render = false;
   bool vtk = false;
+  int vtk_every = 1;  // --vtk-every N: a VTK frame every N-th output (and the last); implies --vtk
   bool quiet = false;
   std::optional<double> checkpoint_every;  // --checkpoint-every T: simulated seconds between checkpoints
 };

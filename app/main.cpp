@@ -19,7 +19,7 @@ const char* kUsage =
     "\n"
     "usage:\n"
     "  aortasph run SCENE.json [--out DIR] [--threads N] [--end-time T] [--set KEY=VALUE]...\n"
-    "                          [--no-render] [--vtk] [--quiet] [--checkpoint-every T]\n"
+    "                          [--no-render] [--vtk] [--vtk-every N] [--quiet] [--checkpoint-every T]\n"
     "  aortasph resume DIR [--threads N] [--quiet]      continue an interrupted run from DIR/checkpoint.bin\n"
     "  aortasph check SCENE.json [--set KEY=VALUE]...   validate and print bodies, counts, h, dt, cost\n"
     "  aortasph compare A B [--diff DIFF.png] [--tolerance T]\n"

@@ -74,7 +74,7 @@ VtkWriter::VtkWriter(const std::filesystem::path& dir) : dir_(dir) {
   if (ec) throw InputError(dir_.string() + ": cannot create folder: " + ec.message());
 }
 
-VtkWriter::VtkWriter(const std::filesystem::path& dir, int keep_frames) : VtkWriter(dir) {
+VtkWriter::VtkWriter(const std::filesystem::path& dir, int keep_frames, int every) : VtkWriter(dir) {
   std::ifstream in(dir_ / "particles.pvd");
   std::string line;
   auto attribute = [&](const std::string& key) -> std::optional<std::string> {
@@ -84,6 +84,7 @@ VtkWriter::VtkWriter(const std::filesystem::path& dir, int keep_frames) : VtkWri
     if (to == std::string::npos) return std::nullopt;
     return line.substr(from, to - from);
   };
+  int strided = 0;
   while (std::getline(in, line)) {
     const auto t = attribute("timestep"), file = attribute("file");
     if (!t || !file) continue;
@@ -91,11 +92,12 @@ VtkWriter::VtkWriter(const std::filesystem::path& dir, int keep_frames) : VtkWri
     if (std::sscanf(file->c_str(), "particles_%d.vtp", &frame) != 1 || frame < 0 || frame >= keep_frames)
       continue;
     files_.emplace_back(std::strtod(t->c_str(), nullptr), *file);
+    if (frame % every == 0) ++strided;
   }
-  if (static_cast<int>(files_.size()) != keep_frames)
-    throw InputError((dir_ / "particles.pvd").string() + ": lists " + std::to_string(files_.size()) +
-                     " of the " + std::to_string(keep_frames) +
-                     " frames written before the checkpoint; cannot resume");
+  const int expected = (keep_frames + every - 1) / every;  // frames 0, every, 2 every, ... below keep_frames
+  if (strided != expected)
+    throw InputError((dir_ / "particles.pvd").string() + ": lists " + std::to_string(strided) + " of the " +
+                     std::to_string(expected) + " frames written before the checkpoint; cannot resume");
 }
 
 VtkWriter::~VtkWriter() = default;

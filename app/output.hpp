@@ -32,8 +32,10 @@ class CsvWriter {
 class VtkWriter {
  public:
   explicit VtkWriter(const std::filesystem::path& dir);
-  // Resuming: keeps the entries of frames 0 .. keep_frames-1 from the existing particles.pvd.
-  VtkWriter(const std::filesystem::path& dir, int keep_frames);
+  // Resuming: keeps the entries of frames 0 .. keep_frames-1 from the existing particles.pvd, which must
+  // list every one of them that is a multiple of `every` (--vtk-every; the run's last output may be there
+  // too).
+  VtkWriter(const std::filesystem::path& dir, int keep_frames, int every = 1);
   void write(const World& world, int frame);
   ~VtkWriter();
 

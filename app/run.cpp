@@ -161,7 +161,12 @@ RunOptions parse_run_options(const std::vector<std::string>& args) {
       o.no_render = true;
     else if (a == "--vtk")
       o.vtk = true;
-    else if (a == "--quiet")
+    else if (a == "--vtk-every") {
+      o.vtk_every = parse_int(a, value());
+      if (o.vtk_every < 1)
+        throw InputError("--vtk-every: expected a positive number of outputs, got " + args[k]);
+      o.vtk = true;
+    } else if (a == "--quiet")
       o.quiet = true;
     else if (a == "--checkpoint-every") {
       o.checkpoint_every = parse_double(a, value());
@@ -196,6 +201,7 @@ struct RunRecord {
   std::string scene_file;
   std::vector<std::string> sets;
   bool no_render = false, vtk = false;
+  int32_t vtk_every = 1;
   double checkpoint_every = 0.0, next_checkpoint = 0.0;
   // --end-time: the end the run uses and the scene file's own (figures are validated against the latter).
   double end_override = 0.0, file_end = 0.0;
@@ -223,6 +229,7 @@ struct RunRecord {
     w.value(range.has_value());
     w.value(range ? range->first : 0.0);
     w.value(range ? range->second : 0.0);
+    out.section("vtk_every", 1).value(vtk_every);
     SectionWriter& c = out.section("camera_ranges", 1);
     c.value(static_cast<uint64_t>(camera_ranges.size()));
     for (const auto& [name, r] : camera_ranges) {
@@ -257,6 +264,12 @@ struct RunRecord {
     const double lo = r.value<double>(), hi = r.value<double>();
     if (has_range) rec.range = std::pair{lo, hi};
     r.done();
+    if (in.has("vtk_every")) {  // a checkpoint without it wrote every output's frame
+      SectionReader v = in.section("vtk_every");
+      rec.vtk_every = v.value<int32_t>();
+      v.done();
+      if (rec.vtk_every < 1) throw InputError(file.string() + ": a VTK stride below 1 (damaged checkpoint)");
+    }
     if (in.has("camera_ranges")) {
       SectionReader c = in.section("camera_ranges");
       const auto count = c.value<uint64_t>();
@@ -307,7 +320,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   if (resume) {
     probe_csv.emplace(dir / "probes.csv", probes.columns(), first_frame);
     diag_csv.emplace(dir / "diagnostics.csv", diagnostics_columns(), first_frame);
-    if (o.vtk) vtk.emplace(dir / "vtk", first_frame);
+    if (o.vtk) vtk.emplace(dir / "vtk", first_frame, o.vtk_every);
   } else {
     probe_csv.emplace(dir / "probes.csv", probes.columns());
     diag_csv.emplace(dir / "diagnostics.csv", diagnostics_columns());
@@ -372,7 +385,10 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
       update_cycles();
     }
     diag_csv->row(diagnostics_row(world));
-    if (vtk) vtk->write(world, frame);
+    // --vtk-every N: frames 0, N, 2N, ... and the last output (the end state, which a study's stress map
+    // reads).
+    if (vtk && (frame % o.vtk_every == 0 || world.time() >= scene.t_end - 1e-9 * scene.output_interval))
+      vtk->write(world, frame);
     if (frames) frames->push(world, frame);
     ++frame;
   };
@@ -384,6 +400,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   rec.sets = o.sets;
   rec.no_render = o.no_render;
   rec.vtk = o.vtk;
+  rec.vtk_every = o.vtk_every;
   rec.checkpoint_every = o.checkpoint_every.value_or(0.0);
   rec.next_checkpoint = record ? record->next_checkpoint : rec.checkpoint_every;
   rec.end_override = o.end_time.value_or(0.0);
@@ -607,6 +624,7 @@ int cmd_resume(const ResumeOptions& ro) {
   o.sets = record.sets;
   o.no_render = record.no_render;
   o.vtk = record.vtk;
+  o.vtk_every = record.vtk_every;
   o.quiet = ro.quiet;
   if (record.checkpoint_every > 0.0) o.checkpoint_every = record.checkpoint_every;
   if (record.end_override > 0.0) o.end_time = record.end_override;

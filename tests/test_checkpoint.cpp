@@ -8,6 +8,7 @@
 
 #include <catch2/catch.hpp>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -386,14 +387,16 @@ TEST_CASE("checkpoint: resume refuses another version, another scene, no checkpo
   CHECK(err.find("no checkpoint") != std::string::npos);
 }
 
-TEST_CASE("checkpoint: resume keeps --end-time (figure times beyond it) and --vtk", "[checkpoint][cli]") {
+TEST_CASE("checkpoint: resume keeps --end-time (figure times beyond it) and --vtk-every",
+          "[checkpoint][cli]") {
   const fs::path scene = scene_file();
   const fs::path whole = scratch("end_whole"), out = scratch("end_resumed");
-  const std::string args = " --quiet --vtk --end-time 0.04";  // the figure's t = 0.06 lies beyond it
+  // The figure's t = 0.06 lies beyond --end-time; a VTK frame every third output and the last.
+  const std::string args = " --quiet --vtk-every 3 --end-time 0.04";
   std::string err;
   REQUIRE(run_cli("run " + scene.string() + args + " --out " + whole.string(), &err) == 0);
-  const pid_t pid =
-      spawn({"run", scene.string(), "--quiet", "--vtk", "--end-time", "0.04", "--out", out.string()});
+  const pid_t pid = spawn(
+      {"run", scene.string(), "--quiet", "--vtk-every", "3", "--end-time", "0.04", "--out", out.string()});
   wait_for_file(out / "frames" / "front" / "frame_00002.png", pid);
   ::kill(pid, SIGINT);
   REQUIRE(wait_for(pid) == 130);
@@ -403,6 +406,16 @@ TEST_CASE("checkpoint: resume keeps --end-time (figure times beyond it) and --vt
   const std::string probes = slurp(out / "probes.csv");
   CHECK(probes == slurp(whole / "probes.csv"));
   CHECK(std::count(probes.begin(), probes.end(), '\n') == 12);  // header + t = 0, 0.004, ..., 0.04
+  // Outputs 0..10: frames 0, 3, 6, 9 and the last, 10, in both runs (the resumed one kept the stride).
+  auto vtp = [](int f) {
+    char name[32];
+    std::snprintf(name, sizeof name, "particles_%05d.vtp", f);
+    return std::string(name);
+  };
+  for (const fs::path& dir : {whole, out}) {
+    for (int f : {0, 3, 6, 9, 10}) CHECK(fs::exists(dir / "vtk" / vtp(f)));
+    for (int f : {1, 2, 4, 5, 7, 8}) CHECK_FALSE(fs::exists(dir / "vtk" / vtp(f)));
+  }
   CHECK(slurp(out / "vtk" / "particles.pvd") == slurp(whole / "vtk" / "particles.pvd"));
   CHECK(slurp(out / "vtk" / "particles_00010.vtp") == slurp(whole / "vtk" / "particles_00010.vtp"));
 }

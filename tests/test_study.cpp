@@ -125,6 +125,11 @@ TEST_CASE("study: the CI study runs end to end through Snakemake, and a second c
     const auto run = nlohmann::json::parse(slurp(out / "variants" / id / "run.json"));
     const std::string set = std::string("open_boundaries.1.pressure=") + (v == 0 ? "41.6" : "141.6");
     CHECK(std::find(run["sets"].begin(), run["sets"].end(), set) != run["sets"].end());
+    // run.vtk = 20: VTK frames of outputs 0, 20, 40 and the last, 60 (0.12 s at 2 ms), for the stress maps.
+    const std::string pvd = slurp(out / "variants" / id / "vtk" / "particles.pvd");
+    CHECK(count_of(pvd, "<DataSet ") == 4);
+    CHECK(fs::exists(out / "variants" / id / "vtk" / "particles_00060.vtp"));
+    CHECK_FALSE(fs::exists(out / "variants" / id / "vtk" / "particles_00001.vtp"));
   }
   // The outlet pressure reached the runs: 100 Pa (0.75 mmHg) more at the outlet raises the aortic pressure.
   CHECK(end_diastolic[1] > end_diastolic[0]);
@@ -253,6 +258,9 @@ TEST_CASE("study: bad study files exit 2 naming the JSON path, before anything i
       {"{ " + scene + ", " + spacing + R"(, "metrics": [ "stroke_volume_ml", "sv" ] })",
        "study.json: metrics[1]: 'sv' is not a cycles.csv column"},
       {"{ " + scene + ", " + spacing + R"(, "run": { "threads": 0 } })", "study.json: run.threads: expected"},
+      {"{ " + scene + ", " + spacing + R"(, "run": { "vtk": 0 } })",
+       "study.json: run.vtk: expected true, false or a whole number of outputs >= 1, got 0"},
+      {"{ " + scene + ", " + spacing + R"(, "run": { "vtk": "last" } })", "study.json: run.vtk: expected"},
       {"[1, 2", "study.json: not valid JSON"},
       {"{ " + scene + R"(, "parameters": [ { "path": "resolution.spacing", "values": [0.002, 0.0025] } ] })",
        "study.json: parameters (variant v001: resolution.spacing=0.0025): open_boundaries[1] 'aorta': the "
