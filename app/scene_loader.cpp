@@ -956,7 +956,7 @@ class Loader {
     const std::string type = j.contains("type") && j["type"].is_string() ? j["type"].get<std::string>() : "";
     std::vector<std::string> keys = {"name", "type"};
     if (type == "extent") keys.insert(keys.end(), {"bodies", "axis", "stat", "region", "link"});
-    if (type == "pressure") keys.insert(keys.end(), {"point"});
+    if (type == "pressure") keys.insert(keys.end(), {"point", "radius", "normal"});
     if (type == "body") keys.insert(keys.end(), {"body"});
     if (type == "point") keys.insert(keys.end(), {"body", "reference"});
     if (type == "flow_rate") keys.insert(keys.end(), {"point", "normal", "radius"});
@@ -998,6 +998,14 @@ class Loader {
     } else if (type == "pressure") {
       p.type = ProbeType::Pressure;
       p.point = o.vec3("point");
+      // Optional sensor face (issue 20, Lobovsky et al. 2014): the mean over a disc of this radius in the
+      // plane normal to `normal`, like a pressure transducer's sensing area.
+      if (o.has("radius")) {
+        p.radius = o.positive("radius");
+        p.normal = o.unit("normal");
+      } else if (o.has("normal")) {
+        fail(o.path("normal"), "only with \"radius\" (the sensor's face)");
+      }
     } else if (type == "body") {
       p.type = ProbeType::BodyState;
       p.body = body_index(s, o.string("body"), o.path("body"));

@@ -13,6 +13,7 @@
 #include "core/neighbors.hpp"
 #include "core/parallel.hpp"
 #include "core/sim_errors.hpp"
+#include "geometry/shapes.hpp"
 #include "physiology/orifice.hpp"
 
 namespace aortasph {
@@ -324,6 +325,41 @@ std::vector<std::string> coaptation_columns(std::size_t leaflets, bool per_leafl
   return cols;
 }
 
+namespace {
+
+// The mean pressure over a sensor's face (issue 20: the wall sensors of Lobovsky et al. 2014): the disc of
+// centre c, unit normal n and radius R, sampled at the 29 points of a square grid of pitch R/3 inside it,
+// each the Shepard-normalised interpolation of the fluid pressure (eq. 4 divided by sum V_j W_ij); a point
+// with no fluid particle within the kernel's support (dry) reads 0. Serial over the particles within R + 2h
+// of c, in index order: the same sum for any thread count.
+double sensor_pressure(const World& world, const Vec3& c, const Vec3& n, double R) {
+  const Particles& P = world.particles();
+  const CubicSpline& K = world.kernel();
+  const double reach = R + K.support;
+  Vec3 u, v;
+  perpendicular_frame(n, u, v);
+  std::vector<Vec3> pts;
+  for (int i = -3; i <= 3; ++i)
+    for (int j = -3; j <= 3; ++j)
+      if (i * i + j * j <= 9) pts.push_back(c + (R / 3.0) * (i * u + j * v));
+  std::vector<double> pw(pts.size(), 0.0), w(pts.size(), 0.0);
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.kind[i] != Kind::Fluid || (P.x[i] - c).squaredNorm() > reach * reach) continue;
+    const double vol = P.m[i] / P.rho[i];
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const double W = K.W((P.x[i] - pts[k]).norm()) * vol;
+      pw[k] += P.p[i] * W;
+      w[k] += W;
+    }
+  }
+  double sum = 0.0;
+  for (std::size_t k = 0; k < pts.size(); ++k)
+    if (w[k] > 0.0) sum += pw[k] / w[k];
+  return sum / static_cast<double>(pts.size());
+}
+
+}  // namespace
+
 ProbeSet::ProbeSet(const Scene& scene, const World& world) : probes_(scene.probes) {
   const Particles& P = world.particles();
   tracked_id_.assign(probes_.size(), 0);
@@ -466,6 +502,10 @@ std::vector<double> ProbeSet::measure(const World& world) const {
       case ProbeType::Pressure: {
         // Shepard-normalised kernel interpolation of the fluid pressure, eq. (4) divided by sum V_j W_ij.
         const CubicSpline& K = world.kernel();
+        if (pr.radius > 0.0) {
+          out.push_back(sensor_pressure(world, pr.point, pr.normal, pr.radius));
+          break;
+        }
         struct PW {
           double pw = 0, w = 0;
         };
