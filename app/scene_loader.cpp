@@ -428,6 +428,7 @@ class Loader {
                 "eos_exponent",
                 "delta_sph",
                 "artificial_viscosity",
+                "riemann_dissipation",
                 "density_summation",
                 "background_pressure",
                 "shifting",
@@ -450,6 +451,9 @@ class Loader {
         m.eos_exponent = o.positive("eos_exponent", 7.0);
         m.delta_sph = o.non_negative("delta_sph", 0.1);
         m.artificial_viscosity = o.non_negative("artificial_viscosity", 0.0);
+        m.riemann_dissipation = o.non_negative("riemann_dissipation", 0.0);
+        if (m.riemann_dissipation > 100.0)
+          fail(o.path("riemann_dissipation"), "must lie in 0..100 (Zhang, Hu & Adams 2017 use 3)");
         m.density_summation = o.boolean("density_summation", false);
         m.background_pressure = o.number("background_pressure", 0.0);
         m.shifting = o.non_negative("shifting", 0.0);

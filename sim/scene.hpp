@@ -39,8 +39,11 @@ struct Material {
   double eos_exponent = 7.0;          // gamma in the Tait equation, paper eq. (13)
   double delta_sph = 0.1;             // density diffusion delta (Antuono et al. 2010); 0 switches it off
   double artificial_viscosity = 0.0;  // Monaghan alpha (Monaghan 1992); 0 switches it off
-  bool density_summation = false;     // eq. (11) instead of the continuity equation (12)
-  double background_pressure = 0.0;   // added to the Tait pressure [Pa]
+  // The momentum dissipation of a low-dissipation Riemann solver (Zhang, Hu & Adams 2017): its limiter
+  // eta (they use 3); 0 switches it off (sim/fluid/fluid_wcsph.cpp, pair_acceleration).
+  double riemann_dissipation = 0.0;
+  bool density_summation = false;    // eq. (11) instead of the continuity equation (12)
+  double background_pressure = 0.0;  // added to the Tait pressure [Pa]
   double shifting = 0.0;  // particle shifting coefficient A (sim/fluid/shifting.hpp); 0 switches it off
   // Transport-velocity formulation (sim/fluid/transport_velocity.hpp): its background pressure p_b [Pa],
   // which drives the advection velocity only (unlike background_pressure above); 0 switches it off.

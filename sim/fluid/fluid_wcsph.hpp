@@ -29,6 +29,7 @@ struct FluidParams {
   double nu = 0.0;
   double delta = 0.0;
   double alpha = 0.0;
+  double riemann_eta = 0.0;  // Riemann-solver dissipation limiter (Zhang, Hu & Adams 2017); 0: off
   double p_background = 0.0;
   double shifting = 0.0;  // particle shifting coefficient A (fluid/shifting.hpp)
   double tv_pb = 0.0;     // transport-velocity background pressure p_b (fluid/transport_velocity.hpp)
@@ -42,6 +43,7 @@ struct FluidParams {
         nu(m.viscosity),
         delta(m.delta_sph),
         alpha(m.artificial_viscosity),
+        riemann_eta(m.riemann_dissipation),
         p_background(m.background_pressure),
         shifting(m.shifting),
         tv_pb(m.transport_velocity_pb),
