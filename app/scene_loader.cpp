@@ -429,6 +429,7 @@ class Loader {
                 "delta_sph",
                 "artificial_viscosity",
                 "riemann_dissipation",
+                "tensile_correction",
                 "density_summation",
                 "background_pressure",
                 "shifting",
@@ -454,6 +455,9 @@ class Loader {
         m.riemann_dissipation = o.non_negative("riemann_dissipation", 0.0);
         if (m.riemann_dissipation > 100.0)
           fail(o.path("riemann_dissipation"), "must lie in 0..100 (Zhang, Hu & Adams 2017 use 3)");
+        m.tensile_correction = o.non_negative("tensile_correction", 0.0);
+        if (m.tensile_correction > 1.0)
+          fail(o.path("tensile_correction"), "must lie in 0..1 (Monaghan 2000 uses 0.2)");
         m.density_summation = o.boolean("density_summation", false);
         m.background_pressure = o.number("background_pressure", 0.0);
         m.shifting = o.non_negative("shifting", 0.0);

@@ -42,6 +42,9 @@ struct Material {
   // The momentum dissipation of a low-dissipation Riemann solver (Zhang, Hu & Adams 2017): its limiter
   // eta (they use 3); 0 switches it off (sim/fluid/fluid_wcsph.cpp, pair_acceleration).
   double riemann_dissipation = 0.0;
+  // Monaghan (2000)'s artificial pressure against the tensile instability: epsilon (he uses 0.2) of the
+  // negative pressures; 0 switches it off (sim/fluid/fluid_wcsph.cpp, pair_acceleration).
+  double tensile_correction = 0.0;
   bool density_summation = false;    // eq. (11) instead of the continuity equation (12)
   double background_pressure = 0.0;  // added to the Tait pressure [Pa]
   double shifting = 0.0;  // particle shifting coefficient A (sim/fluid/shifting.hpp); 0 switches it off

@@ -87,6 +87,7 @@ World::World(const Scene& scene)
       ctx_{kernel_, fluid_, gravity_, {}, {}, Periodic(scene.domain, scene.periodic)} {
   const double dx = scene_.spacing;
   const double volume = dx * dx * dx;
+  ctx_.inv_w_dx = 1.0 / kernel_.W(dx);
   std::vector<uint8_t> clamped;       // per particle: elastic and held in place
   std::vector<ShellSeed> shell_seed;  // per particle: shells' normal, area and support
 

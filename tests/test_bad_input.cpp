@@ -221,6 +221,8 @@ TEST_CASE("bad input: malformed scenes and arguments exit 2 naming the problem",
       {"negative density-error limit", good, "--set time.max_density_error=-1", "time.max_density_error"},
       {"negative Riemann dissipation", good, "--set materials.water.riemann_dissipation=-1",
        "materials.water.riemann_dissipation: must not be negative"},
+      {"tensile correction beyond 1", good, "--set materials.water.tensile_correction=1.5",
+       "materials.water.tensile_correction: must lie in 0..1"},
       {"Riemann dissipation beyond 100", good, "--set materials.water.riemann_dissipation=101",
        "materials.water.riemann_dissipation: must lie in 0..100"},
       // References that do not resolve.

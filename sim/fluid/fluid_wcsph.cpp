@@ -208,6 +208,17 @@ inline Vec3 local_wall_term(const FluidContext& ctx, const PairConstants& c, con
   return -2.0 * beta * du / (rhoi + rhoj);
 }
 
+// The tensile correction's share of pair_acceleration's scalar (see there).
+[[gnu::noinline]] double tensile_term(const FluidContext& ctx, const FluidParams& fi, const FluidI& I,
+                                      const Particles& P, std::size_t j, double r) {
+  const double tension = std::max(-I.p_over_rho2, 0.0) + std::max(-ctx.p_over_rho2[j], 0.0);
+  if (tension == 0.0) return 0.0;
+  const double eps = 0.5 * (fi.tensile + ctx.params[P.material[j]].tensile);
+  const double f = ctx.kernel.W(r) * ctx.inv_w_dx;
+  const double f2 = f * f;
+  return -eps * tension * f2 * f2;
+}
+
 // Inlined into the pair loops: out of line (GCC's choice once the shell and transport-velocity terms were
 // added) the force loop of the aortic bench took about 15 % longer (docs/performance.md, issue 18).
 [[gnu::always_inline]] inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx,
@@ -253,6 +264,12 @@ inline Vec3 local_wall_term(const FluidContext& ctx, const PairConstants& c, con
   // arrived 17 % late; Zhang et al. use the wall-normal velocity, which these walls do not carry). The
   // solver's continuity half is left to delta-SPH. Out of line: only scenes with the key reach it.
   if (fi.riemann_eta > 0.0 && fluid_j) scalar += riemann_term(ctx, fi, P, j, vij, xij, r, rhoi, rhoj);
+  // Artificial pressure against the tensile instability (Monaghan 2000, J. Comput. Phys. 159:290, eqs. 4.2,
+  // 4.3 and 4.7): the pair bracket p_i/rho_i^2 + p_j/rho_j^2 gains R f^n, f = W(r) / W(dx), n = 4, R = R_i +
+  // R_j, R_i = eps |p_i| / rho_i^2 where p_i < 0 (zero otherwise): a short-range repulsion that appears only
+  // under tension, where particles would otherwise pair up and clump. Symmetric in i and j (eps averaged
+  // over the two materials), so pair forces still cancel. Fluid pairs only; out of line.
+  if (fi.tensile > 0.0 && fluid_j) scalar += tensile_term(ctx, fi, I, P, j, r);
   Vec3 acc = (mj * scalar) * gradW;
 
   // Viscosity, eq. (10), in the form symmetric in i and j (Morris, Fox & Zhu 1997, eq. 8): 2/rho_j becomes

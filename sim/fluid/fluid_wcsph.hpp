@@ -30,6 +30,7 @@ struct FluidParams {
   double delta = 0.0;
   double alpha = 0.0;
   double riemann_eta = 0.0;  // Riemann-solver dissipation limiter (Zhang, Hu & Adams 2017); 0: off
+  double tensile = 0.0;      // Monaghan 2000's artificial-pressure epsilon; 0: off
   double p_background = 0.0;
   double shifting = 0.0;  // particle shifting coefficient A (fluid/shifting.hpp)
   double tv_pb = 0.0;     // transport-velocity background pressure p_b (fluid/transport_velocity.hpp)
@@ -44,6 +45,7 @@ struct FluidParams {
         delta(m.delta_sph),
         alpha(m.artificial_viscosity),
         riemann_eta(m.riemann_dissipation),
+        tensile(m.tensile_correction),
         p_background(m.background_pressure),
         shifting(m.shifting),
         tv_pb(m.transport_velocity_pb),
@@ -75,6 +77,7 @@ struct FluidContext {
   // Per particle: the transport velocity's correction v~ - v of this step (fluid/transport_velocity.hpp),
   // zero where a material has it off; empty when no material has it on.
   std::vector<Vec3> transport_dv = {};
+  double inv_w_dx = 0.0;  // 1 / W(particle spacing): the tensile correction's reference (World sets it)
   // x_i - x_j, or its nearest image along periodic axes.
   Vec3 separation(const Vec3& xi, const Vec3& xj) const {
     return periodic.any ? periodic.image(xi - xj) : Vec3(xi - xj);
