@@ -16,6 +16,11 @@ py=${AORTASPH_PYTHON:-/usr/bin/python3}
 mkdir -p "$out"
 runs=()
 for n in "${divs[@]}"; do
+  # The scene's domain holds the tank's 3 wall layers down to H/15 (layers of 20 mm within its 60 mm margin).
+  if ! [[ "$n" =~ ^[0-9]+$ ]] || [ "$n" -lt 15 ]; then
+    echo "validate_lobovsky.sh: $n: give divisions of H of at least 15 (H/15 = 20 mm spacing)" >&2
+    exit 2
+  fi
   dx=$("$py" -c "print(0.3 / $n)")
   width=$("$py" -c "print(8 * 0.3 / $n)")  # the periodic slab: 8 spacings (at least 7.15 are needed)
   sets=(--set "resolution.spacing=$dx" --set "domain.max.2=$width" --set "bodies.0.shape.box.max.2=$width"
