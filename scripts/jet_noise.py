@@ -66,7 +66,7 @@ def cubic_w(q):
     return w
 
 
-def noise(arr, args):
+def noise(arr, args, want_fields=False):
     x = arr['points']
     body = arr['body'].astype(int)
     blood = body == args.body
@@ -95,6 +95,8 @@ def noise(arr, args):
         dp2.append(float((pb[i] - pbar) ** 2))
     d, _ = tree.query(xb[sel], k=2)
     nn = d[:, 1]
+    if want_fields:
+        return xb[sel], np.linalg.norm(vb[sel], axis=1), np.sqrt(np.array(dv2))
     return {
         'particles': int(len(sel)),
         'vel_noise': math.sqrt(np.mean(dv2)) / max(math.sqrt(np.mean(vbar2)), 1e-12),
@@ -103,6 +105,36 @@ def noise(arr, args):
         'close': float(np.mean(nn < 0.5 * args.dx)),
         'nn_cv': float(nn.std() / nn.mean()),
     }
+
+
+def plot_sections(args):
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    runs = [spec.split('=', 1) for spec in args.runs]
+    wide = argparse.Namespace(**vars(args))  # the whole lumen in the pictures, not only the measured region
+    wide.radius, wide.ymin, wide.ymax = 1.0, -1.0, 1.0
+    fig, axes = plt.subplots(len(runs), 3, figsize=(12, 5.0 * len(runs)), squeeze=False)
+    for row, (label, run_dir) in enumerate(runs):
+        fr = frames(run_dir)[-2:]
+        for col in range(3):
+            t, path = fr[min(col, len(fr) - 1)]
+            x, speed, res = noise(read_vtp(path), wide, want_fields=True)
+            cut = np.abs(x[:, 2]) < 0.5 * args.dx
+            ax = axes[row, col]
+            if col < 2:
+                sc = ax.scatter(1e3 * x[cut, 0], 1e3 * x[cut, 1], c=speed[cut], s=12, cmap='viridis', vmin=0, vmax=2.0)
+                what = f'speed, t = {1e3 * t:.0f} ms'
+            else:
+                sc = ax.scatter(1e3 * x[cut, 0], 1e3 * x[cut, 1], c=res[cut], s=12, cmap='magma_r', vmin=0, vmax=0.5)
+                what = f'|v - <v>|, t = {1e3 * t:.0f} ms'
+            fig.colorbar(sc, ax=ax, shrink=0.6, label='m/s')
+            ax.set_aspect('equal')
+            ax.set_title(f'{label}: {what}', fontsize=9)
+            ax.set_xlabel('x [mm]')
+            ax.set_ylabel('y [mm]')
+    fig.tight_layout()
+    fig.savefig(args.png, dpi=100)
 
 
 def valve_numbers(run_dir):
@@ -140,6 +172,8 @@ def main():
     ap.add_argument('--ymin', type=float, default=0.002)
     ap.add_argument('--ymax', type=float, default=0.024)
     ap.add_argument('--json')
+    ap.add_argument('--png', help='a section |z| < dx/2 of each run (rows): speed at the last two frames and '
+                                  'the velocity residual |v - <v>| at the last one (matplotlib)')
     ap.add_argument('runs', nargs='+', help='LABEL=RUN_DIR')
     args = ap.parse_args()
     result = {}
@@ -165,6 +199,8 @@ def main():
         if v:
             result[label + ':valve'] = v
             print(f'{label:<14} ' + '  '.join(f'{k} {val:.3g}' for k, val in v.items()))
+    if args.png:
+        plot_sections(args)
     if args.json:
         with open(args.json, 'w') as f:
             json.dump(result, f, indent=1)
