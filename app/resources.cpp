@@ -1,5 +1,6 @@
 #include "resources.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -66,13 +67,15 @@ double bytes_per_particle(const Scene& scene) {
   return 160.0 + 4.0 * neighbours * 1.5 + 100.0;
 }
 
-double estimate_output_bytes(const Scene& scene, double particles, long outputs, bool render, bool vtk) {
-  double per_output = 0.0;
+double estimate_output_bytes(const Scene& scene, double particles, long outputs, bool render, int vtk_every) {
+  const double n = static_cast<double>(std::max(outputs, 0L));
+  double bytes = 0.0;
   if (render)
-    per_output += static_cast<double>(scene.render.cameras.size()) * scene.render.width *
-                  scene.render.height * 3.0 / 4.0;
-  if (vtk) per_output += 170.0 * particles;
-  return per_output * static_cast<double>(std::max(outputs, 0L));
+    bytes += n * static_cast<double>(scene.render.cameras.size()) * scene.render.width * scene.render.height *
+             3.0 / 4.0;
+  // --vtk-every N writes every N-th output's frame and the last one.
+  if (vtk_every > 0) bytes += 170.0 * particles * std::min(n, std::ceil(n / vtk_every) + 1.0);
+  return bytes;
 }
 
 std::optional<double> available_memory() {
@@ -86,7 +89,7 @@ std::optional<double> available_memory() {
 }
 
 void check_resources(const Scene& scene, const std::filesystem::path& dir, long outputs, bool render,
-                     bool vtk) {
+                     int vtk_every) {
   const double particles = estimate_particles(scene);
   const double need = particles * bytes_per_particle(scene);
   if (const auto have = available_memory(); have && need > *have) {
@@ -98,7 +101,7 @@ void check_resources(const Scene& scene, const std::filesystem::path& dir, long 
         << " are available (MemAvailable); use a coarser resolution.spacing or smaller bodies";
     throw InputError(msg.str());
   }
-  const double write = estimate_output_bytes(scene, particles, outputs, render, vtk);
+  const double write = estimate_output_bytes(scene, particles, outputs, render, vtk_every);
   std::error_code ec;
   const auto space = std::filesystem::space(dir, ec);
   if (!ec && write > static_cast<double>(space.available)) {

@@ -21,15 +21,16 @@ double bytes_per_particle(const Scene& scene);
 
 // Bytes the frames of the remaining outputs will take: a PNG of these renders compresses to about a quarter
 // of its raw RGB size (width * height * 3 / 4; measured 0.05..0.3 on the project's scenes, so this is
-// generous), per camera and output; with vtk also about 170 B per particle and output (ASCII .vtp).
-double estimate_output_bytes(const Scene& scene, double particles, long outputs, bool render, bool vtk);
+// generous), per camera and output; with VTK frames (vtk_every >= 1: every vtk_every-th output and the last;
+// 0: none) also about 170 B per particle and frame (ASCII .vtp).
+double estimate_output_bytes(const Scene& scene, double particles, long outputs, bool render, int vtk_every);
 
 // MemAvailable of /proc/meminfo in bytes, or nothing when it cannot be read.
 std::optional<double> available_memory();
 
 // Throws InputError when the estimated memory exceeds what is available, or the estimated output exceeds the
-// free space under dir. outputs: the outputs still to be written.
+// free space under dir. outputs: the outputs still to be written; vtk_every as for estimate_output_bytes.
 void check_resources(const Scene& scene, const std::filesystem::path& dir, long outputs, bool render,
-                     bool vtk);
+                     int vtk_every);
 
 }  // namespace aortasph

@@ -302,7 +302,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   const int first_frame = record ? record->frames : 0;
   const bool render = !o.no_render && !scene.render.cameras.empty();
   check_resources(scene, dir, outputs + 1 - first_frame + (scene.t_end > outputs * scene.output_interval),
-                  render, o.vtk);
+                  render, o.vtk ? o.vtk_every : 0);
 
   if (!resume) {
     // A checkpoint left by an earlier run in this folder would no longer match the files this run writes.

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cli_helpers.hpp"
+#include "resources.hpp"
 
 namespace fs = std::filesystem;
 using aortasph::test::run_cli;
@@ -331,6 +332,16 @@ TEST_CASE("bad input: render settings are refused by check, and by run before an
     CHECK(run_cli("run " + scene + " --quiet --no-render --out " + out.string() + " --set " + r.set, err) ==
           0);
   }
+}
+
+TEST_CASE("disk estimate: --vtk-every N counts every N-th VTK frame and the last", "[bad-input]") {
+  aortasph::Scene scene;  // no cameras: only the VTK frames count
+  const double per_frame = 170.0 * 1000.0;
+  CHECK(aortasph::estimate_output_bytes(scene, 1000.0, 100, false, 0) == 0.0);
+  CHECK(aortasph::estimate_output_bytes(scene, 1000.0, 100, false, 1) == Approx(100 * per_frame));
+  // Frames 0, 25, 50, 75 and the last: 5 of 100, not 100.
+  CHECK(aortasph::estimate_output_bytes(scene, 1000.0, 100, false, 25) == Approx(5 * per_frame));
+  CHECK(aortasph::estimate_output_bytes(scene, 1000.0, 3, false, 100) == Approx(2 * per_frame));
 }
 
 TEST_CASE("bad input: a write error during a run (disk full) exits 2 naming the file", "[bad-input][cli]") {
