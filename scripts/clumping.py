@@ -33,7 +33,7 @@ def main():
         for t, path in frames(run_dir):
             a = read_vtp(path)
             keep = np.isin(a['body'].astype(int), args.bodies)
-            x = a['points'][keep]
+            x = a['Points'][keep]
             if len(x) < 2:
                 continue
             d, _ = cKDTree(x).query(x, k=2)

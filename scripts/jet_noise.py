@@ -28,22 +28,12 @@ import sys
 import numpy as np
 from scipy.spatial import cKDTree
 
+import study_report  # noqa: E402 (same folder: its .vtp reader)
+
 
 def read_vtp(path):
-    text = open(path).read()
-    arrays = {}
-    for m in re.finditer(r'<DataArray([^>]*)>(.*?)</DataArray>', text, re.S):
-        head, body = m.group(1), m.group(2)
-        name = re.search(r'Name="([^"]+)"', head)
-        comps = re.search(r'NumberOfComponents="(\d+)"', head)
-        key = name.group(1) if name else 'points'
-        if key in arrays:  # connectivity/offsets of verts and polys: not needed
-            continue
-        data = np.array(body.split(), dtype=float)
-        if comps and int(comps.group(1)) > 1:
-            data = data.reshape(-1, int(comps.group(1)))
-        arrays[key] = data
-    return arrays
+    """study_report.py's reader of the ascii .vtp files, as numpy arrays ('Points' is the positions)."""
+    return {name: np.asarray(values, dtype=float) for name, values in study_report.read_vtp(path).items()}
 
 
 def frames(run_dir):
@@ -67,7 +57,7 @@ def cubic_w(q):
 
 
 def noise(arr, args, want_fields=False):
-    x = arr['points']
+    x = arr['Points']
     body = arr['body'].astype(int)
     blood = body == args.body
     xb, vb, pb = x[blood], arr['velocity'][blood], arr['pressure'][blood]

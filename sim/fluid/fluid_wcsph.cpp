@@ -202,8 +202,7 @@ inline Vec3 local_wall_term(const FluidContext& ctx, const PairConstants& c, con
 // of a flow separate, so the call is saved for them.
 [[gnu::noinline]] double riemann_term(const FluidContext& ctx, const FluidParams& fi, const Particles& P,
                                       std::size_t j, double vx, double r, double rhoi, double rhoj) {
-  const double du = -vx / r;  // U_L - U_R, positive when approaching
-  if (du <= 0.0) return 0.0;
+  const double du = -vx / r;  // U_L - U_R, positive: the caller passes approaching pairs only
   const double cbar = 0.5 * (fi.c0 + ctx.params[P.material[j]].c0);
   const double beta = std::min(fi.riemann_eta * du, cbar);
   return -2.0 * beta * du / (rhoi + rhoj);
