@@ -256,7 +256,7 @@ World::World(const Scene& scene)
     std::vector<ShellSeed> by_index(P_.size());
     for (std::size_t i = 0; i < P_.size(); ++i)
       if (P_.id[i] < shell_seed.size()) by_index[i] = shell_seed[P_.id[i]];
-    shells_ = Shells(P_, scene_.materials, kernel_, by_index);
+    shells_ = Shells(P_, scene_.materials, kernel_, by_index, ctx_.periodic);
     shells_.update(P_);
     {  // the sheets drawn and written for the shell bodies: edges up to 1.5 dx (solid/shell_mesh.hpp)
       std::vector<uint16_t> body_of(shells_.size());

@@ -42,8 +42,8 @@ double von_mises_plane(const Mat3& S) {
 }  // namespace
 
 Shells::Shells(const Particles& P, const std::vector<Material>& materials, const CubicSpline& kernel,
-               const std::vector<ShellSeed>& seed)
-    : h_(kernel.h) {
+               const std::vector<ShellSeed>& seed, const Periodic& per)
+    : h_(kernel.h), per_(per) {
   params_.resize(materials.size());
   for (std::size_t m = 0; m < materials.size(); ++m)
     if (materials[m].type == MaterialType::Shell) params_[m] = ShellParams(materials[m]);
@@ -76,6 +76,7 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
 
   // Reference neighbours within the kernel support, of one body.
   NeighborSearch nb;
+  nb.set_periodic(per_);
   nb.build(X_, kernel.support);
   std::vector<uint16_t> body(n);
   for (std::size_t s = 0; s < n; ++s) body[s] = P.body[at_[s]];
@@ -113,7 +114,7 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
     Mat2 M = Mat2::Zero();
     std::vector<Eigen::Vector2d> hv(offset_[s + 1] - offset_[s]);
     for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
-      const Vec3 X = X_[nbr_[k]] - X_[s];
+      const Vec3 X = sep(X_[nbr_[k]], X_[s]);
       const double r = X.norm();
       const Eigen::Vector2d a(T1_[s].dot(X), T2_[s].dot(X));
       const Eigen::Vector2d hh = (kernel.dWdr(r) / r) * a;
@@ -135,7 +136,7 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
     Mat32 G0 = Mat32::Zero(), H0 = Mat32::Zero();
     for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
       const uint32_t t = nbr_[k];
-      G0 += area_[t] * (X_[t] - X_[s]) * g_[k].transpose();
+      G0 += area_[t] * sep(X_[t], X_[s]) * g_[k].transpose();
       H0 += area_[t] * (N_[t] - N_[s]) * g_[k].transpose();
     }
     if (offset_[s] == offset_[s + 1]) G0 << T1_[s], T2_[s];
@@ -152,7 +153,7 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
     const Mat3& K = K0_[kGauss * s];
     for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
       const uint32_t t = nbr_[k];
-      const Vec3 X = X_[t] - X_[s];
+      const Vec3 X = sep(X_[t], X_[s]);
       b_[k] = K * X;
       // Hourglass stiffness: alpha E t / (1 - nu^2) A_s A_t W / (|X|^2 Wbar), Wbar the mean kernel sum of
       // the pair, so that sum_t k |eps|^2 ~ alpha (E t) A |grad eps|^2: the membrane stiffness' scale.
@@ -197,7 +198,7 @@ void Shells::update(const Particles& P) {
     Mat32 G = Mat32::Zero(), H = Mat32::Zero();
     for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
       const uint32_t t = nbr_[k];
-      G += area_[t] * (x_[t] - x_[s]) * g_[k].transpose();
+      G += area_[t] * sep(x_[t], x_[s]) * g_[k].transpose();
       H += area_[t] * (d_[t] - d_[s]) * g_[k].transpose();
     }
     if (offset_[s] == offset_[s + 1]) G << T1_[s], T2_[s];
@@ -263,9 +264,9 @@ void Shells::update(const Particles& P) {
     double U = 0.0;
     for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
       const uint32_t t = nbr_[k];
-      const Vec3 X = X_[t] - X_[s];
+      const Vec3 X = sep(X_[t], X_[s]);
       const double beta = std::min(1.0, kHgTransverse * sp.t * sp.t / X.squaredNorm());
-      const Vec3 eps = 0.5 * (F0_[s] + F0_[t]) * X - (x_[t] - x_[s]);
+      const Vec3 eps = 0.5 * (F0_[s] + F0_[t]) * X - sep(x_[t], x_[s]);
       const double kk = k_hg_[k];
       // The pair's energy 1/2 k eps^T A eps, A = I - (1 - beta) n n^T with n the pair's mean director: the
       // component of eps across the sheet (a transverse zig-zag of the pair) is penalised at the bending

@@ -38,6 +38,7 @@
 
 #include "core/kernel.hpp"
 #include "core/particles.hpp"
+#include "core/periodic.hpp"
 #include "core/slot_map.hpp"
 #include "solid/shell_material.hpp"
 
@@ -56,9 +57,12 @@ class Shells {
   using Mat2 = Eigen::Matrix2d;
 
   Shells() = default;
-  // Reference configuration of every Kind::Shell particle of P; seed is indexed like P.
+  // Reference configuration of every Kind::Shell particle of P; seed is indexed like P. Along periodic axes
+  // (per) a sheet continues through the domain's faces: neighbours and every pair separation, in the
+  // reference and now, are nearest images (a plate strip periodic across its width is in cylindrical
+  // bending, the plane-strain plate of quasi-2-D benchmarks).
   Shells(const Particles& P, const std::vector<Material>& materials, const CubicSpline& kernel,
-         const std::vector<ShellSeed>& seed);
+         const std::vector<ShellSeed>& seed, const Periodic& per = Periodic());
 
   std::size_t size() const { return X_.size(); }
   bool empty() const { return X_.empty(); }
@@ -135,6 +139,9 @@ class Shells {
   static constexpr int kGauss = 3;
   std::vector<ShellParams> params_;  // per material
   double h_ = 0.0;
+  Periodic per_;
+  // x_t - x_s, or its nearest image along periodic axes.
+  Vec3 sep(const Vec3& xt, const Vec3& xs) const { return per_.any ? per_.image(xt - xs) : Vec3(xt - xs); }
   // Reference, per shell slot.
   std::vector<uint32_t> id_;
   std::vector<Vec3> X_, N_, T1_, T2_;
