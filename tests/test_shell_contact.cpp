@@ -246,3 +246,53 @@ TEST_CASE("shell contact: 1 vs 2 threads bitwise identical", "[shell_contact][he
   set_threads(threads);
   CHECK(h[0] == h[1]);
 }
+
+TEST_CASE(
+    "shell contact: a wall beyond a sheet's free edge, in its plane, is not in contact; a held particle "
+    "does not bound the step",
+    "[shell_contact]") {
+  // A 10 x 10 mm free sheet in the plane z = 0 whose +x edge row lies at x = 4.5 mm; a block of wall 1 mm
+  // thick starts 1 mm beyond it (first column at x = 5.5 mm), its middle layer in the sheet's plane: edge on
+  // (the aortic leaflets' free edges against the commissure posts). The edge particles' tangent plane passes
+  // through the block's particles (gap ~ 0), where a barrier would be stiff without bound; but the block is
+  // 1 mm from the sheet's edge, beyond the patch of its edge particles (dx / 2): no contact.
+  const ShellContact contact({kK, -1.0, 0.5, kDx}, 2.6 * kDx);
+  auto scene = [&](double wall_x0, bool held) {
+    Scene s = base_scene();
+    s.materials = {sheet_material(0.0), wall()};
+    s.bodies = {plate("sheet", 0, Vec3(0, 0, 0), 10 * kDx, 10 * kDx, Vec3::UnitZ()),
+                box_body("block", 1, Vec3(wall_x0, -0.005, -1.5e-3), Vec3(wall_x0 + 2e-3, 0.005, 1.5e-3))};
+    if (held)
+      s.bodies[0].shell_fixed = {Box{Vec3(3e-3, -1, -1), Vec3(1, 1, 1)}};  // the two edge rows clamped
+    return s;
+  };
+  World beyond(scene(5e-3, false));
+  const Particles& P = beyond.particles();
+  std::vector<Vec3> f(P.size(), Vec3::Zero());
+  contact.add_forces(P, beyond.neighbors(), beyond.shells(), Periodic(), f);
+  double fmax = 0.0;
+  for (std::size_t i = 0; i < P.size(); ++i) fmax = std::max(fmax, f[i].norm());
+  const double dt_beyond = contact.stable_dt(P, beyond.neighbors(), beyond.shells(), Periodic(), 0.5);
+  INFO("edge on, 1 mm beyond the edge: largest contact force " << fmax << " N, contact step " << dt_beyond);
+  CHECK(fmax < 1e-12 * kP * kDx * kDx);  // (a pair at the patch kernel's last round-off may remain)
+  CHECK(dt_beyond > 1.0);
+  // The block at the edge's patch (first column at x = 5.0 mm, where the patches of the edge row end), the
+  // two rows along the edge clamped: those particles lie in the block's plane at a gap ~ 0, but they do not
+  // move, so they bound no step; the free rows are 2.5 mm or more from the block.
+  World held(scene(4.5e-3, true));
+  const double dt_held =
+      contact.stable_dt(held.particles(), held.neighbors(), held.shells(), Periodic(), 0.5);
+  INFO("edge rows clamped, the block at their patches' end: contact step " << dt_held);
+  CHECK(dt_held > 1.0);
+  // Over the sheet the block still is in contact: moved to lie across the edge (x from 3.5 mm), its particles
+  // above and below the edge rows are within the contact distance of the edge particles' planes.
+  World over(scene(3.5e-3, false));
+  const Particles& Q = over.particles();
+  std::vector<Vec3> g(Q.size(), Vec3::Zero());
+  contact.add_forces(Q, over.neighbors(), over.shells(), Periodic(), g);
+  double gmax = 0.0;
+  for (std::size_t i = 0; i < Q.size(); ++i)
+    if (Q.kind[i] == Kind::Shell) gmax = std::max(gmax, g[i].norm());
+  INFO("the block across the edge: largest contact force on the sheet " << gmax << " N");
+  CHECK(gmax > 0.0);
+}

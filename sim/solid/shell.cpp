@@ -110,6 +110,20 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
   // a_st^T)^-1, so that sum_t A_t (f_t - f_s) g_st^T is exact for every field linear in the tangent plane.
   g_.resize(nbr_.size());
   std::vector<double> ksum(n, 0.0);
+  // Particles near an edge (over_sheet): the first moment of the reference neighbourhood over 0.08 of the
+  // neighbours' mean distance (about 0.1 dx on a lattice at h = 1.3 dx).
+  edge_.assign(n, 0);
+  parallel_for(n, [&](std::size_t s) {
+    Vec3 moment = Vec3::Zero();
+    double dist = 0.0;
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const Vec3 X = sep(X_[nbr_[k]], X_[s]);
+      const double w = kernel.W(X.norm());
+      moment += w * X;
+      dist += w * X.norm();
+    }
+    edge_[s] = offset_[s] == offset_[s + 1] || moment.norm() > 0.08 * dist;
+  });
   parallel_for(n, [&](std::size_t s) {
     Mat2 M = Mat2::Zero();
     std::vector<Eigen::Vector2d> hv(offset_[s + 1] - offset_[s]);

@@ -95,6 +95,19 @@ class Shells {
   double rotary_inertia(std::size_t s) const { return inertia_[s]; }
   // Current mid-surface normal (G column 0 x column 1, normalised; oriented like N).
   Vec3 normal(std::size_t s) const;
+  // Whether the point x_s + r (r from the particle's position at the last update()) lies over its sheet:
+  // within `reach` of the particle or of one of its reference neighbours, where they are now. Inside a
+  // sheet every nearby point does (true at once); near an edge (the two or three rows whose reference
+  // neighbourhood's first moment, sum_t W (X_t - X_s) / sum_t W, exceeds 0.08 of the neighbours' mean
+  // distance, about 0.1 dx: the fluid coupling's test) a point beyond the edge does not.
+  bool over_sheet(std::size_t s, const Vec3& r, double reach) const {
+    if (!edge_[s]) return true;
+    const double r2 = reach * reach;
+    if (r.squaredNorm() <= r2) return true;
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k)
+      if ((sep(x_[nbr_[k]], x_[s]) - r).squaredNorm() <= r2) return true;
+    return false;
+  }
   const Vec3& torque(std::size_t s) const { return torque_[s]; }
   // Internal force of the last update() on slot s [N] (what add_forces() adds).
   const Vec3& internal_force(std::size_t s) const { return force_[s]; }
@@ -146,6 +159,7 @@ class Shells {
   std::vector<uint32_t> id_;
   std::vector<Vec3> X_, N_, T1_, T2_;
   std::vector<double> area_, mass_, inertia_;
+  std::vector<uint8_t> edge_;  // 1 for a particle near an edge of its sheet (over_sheet)
   std::vector<uint16_t> material_;
   std::vector<uint8_t> support_;
   // Per Gauss point k of slot s (index 3 s + k): J0^-1 and the reference volume A w_k det(J0_k) / det(J0_0).

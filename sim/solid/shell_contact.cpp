@@ -90,6 +90,14 @@ ShellContact::Pair ShellContact::pair(const Particles& P, const Shells& sh, std:
     if (g >= 2.0 * dc) return Vec3::Zero();
     const double rho = std::sqrt(std::max(d.squaredNorm() - sn * sn, 0.0));
     if (rho >= 2.0 * dx) return Vec3::Zero();
+    // A wall or elastic particle whose foot on the plane, x_o - s n, lies beyond an edge of the sheet (not
+    // within dx / sqrt(2) of a particle of it: the patches of a lattice of spacing dx cover the sheet out to
+    // dx / 2 beyond its edge rows) is not over the sheet: edge on, it sits near the plane of the particles
+    // along the edge, whose gap says nothing about the contact (two sheets share such a pair by their gaps,
+    // above). Without this, a wall particle in the plane of a free edge (a commissure post) set a barrier
+    // stiffness without bound and a step of 1e-8 s.
+    if (!(a_shell && b_shell) && !sh.over_sheet(slot(s), d - sn * n, std::sqrt(0.5) * dx))
+      return Vec3::Zero();
     const double w = weight * area_a * area_b * W2(rho, dx);
     const Vec3 e = sn >= 0.0 ? n : Vec3(-n);  // from q's plane towards o
     const double rate = v.dot(e);             // d(gap)/dt
@@ -162,6 +170,7 @@ double ShellContact::stable_dt(const Particles& P, const NeighborSearch& nb, con
   return parallel_reduce(
       sh.size(), kInf,
       [&](std::size_t s) {
+        if (sh.support(s) == 1 || sh.support(s) == 2) return kInf;  // held in place: no step to bound
         const std::size_t i = sh.at(s);
         double k = 0.0, c = 0.0, close = kInf;
         bool near = false;
