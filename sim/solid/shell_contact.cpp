@@ -106,10 +106,14 @@ ShellContact::Pair ShellContact::pair(const Particles& P, const Shells& sh, std:
     // parallel sheets): edge on, the edge particle's own plane holds the partner at a gap near 0 with a
     // share near 0, and its closing time (gap / speed, ~1e-6 s in the closing valve) would set the step for
     // nothing.
+    // The closing time is taken on a gap of at least 0.1 d_c: closer, the barrier (9 K and more) and its
+    // stiffness bound the step (k below); without the floor, a partner whose foot passes through the
+    // tangent plane far out on the patch (a wall particle beside a curved leaflet) drove the step towards
+    // zero as gap / speed (1e-9 s in the valve scene).
     if (weight >= 0.5) {
       out.gap = std::min(out.gap, g);
       if (rate < 0.0) {
-        const double tc = g / -rate;
+        const double tc = std::max(g, 0.1 * dc) / -rate;
         out.dt_close = out.dt_close > 0.0 ? std::min(out.dt_close, tc) : tc;
       }
     }
