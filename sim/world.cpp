@@ -258,10 +258,11 @@ World::World(const Scene& scene)
       if (P_.id[i] < shell_seed.size()) by_index[i] = shell_seed[P_.id[i]];
     shells_ = Shells(P_, scene_.materials, kernel_, by_index, ctx_.periodic);
     shells_.update(P_);
-    {  // the sheets drawn and written for the shell bodies: edges up to 1.5 dx (solid/shell_mesh.hpp)
+    {  // the sheets drawn and written for the shell bodies: edges up to 1.75 dx (solid/shell_mesh.hpp; the
+       // curved sampling of the aortic leaflets has cells with both diagonals 1.52 dx, holes at 1.5 dx)
       std::vector<uint16_t> body_of(shells_.size());
       for (std::size_t s = 0; s < shells_.size(); ++s) body_of[s] = P_.body[shells_.at(s)];
-      sheets_ = ShellSheets(shells_, body_of, 1.5 * dx);
+      sheets_ = ShellSheets(shells_, body_of, 1.75 * dx);
     }
     shell_contact_ = ShellContact(
         {scene_.contact.shell_stiffness, scene_.contact.shell_margin, scene_.contact.shell_damping, dx},

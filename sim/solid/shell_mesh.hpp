@@ -35,7 +35,7 @@ std::vector<Triangle> triangulate_sheet(const std::vector<Vec3>& X, const std::v
 class ShellSheets {
  public:
   ShellSheets() = default;
-  // body: the body index of each shell slot; max_edge: 1.5 dx.
+  // body: the body index of each shell slot; max_edge: 1.75 dx (the World's choice).
   ShellSheets(const Shells& shells, const std::vector<uint16_t>& body, double max_edge);
   bool empty() const { return triangles_.empty(); }
   // Triangles of all bodies, by shell slot, and the body of each.
