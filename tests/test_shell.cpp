@@ -116,6 +116,7 @@ TEST_CASE("shell patch test: a uniform in-plane stretch gives the analytic membr
     CHECK(std::abs(N(0, 1)) < 1e-9 * N11);
     CHECK(sh.moment(s).norm() < 1e-9 * N11 * t);
     CHECK(sh.shear(s).norm() < 1e-9 * N11);
+    CHECK(sh.strain(s) == Approx(E11).epsilon(1e-9));  // the larger principal strain (the stress probe's)
   }
 }
 

@@ -694,8 +694,8 @@ std::vector<double> ProbeSet::measure(const World& world) const {
             });
         const MS all{std::max(r.max, rs.max), r.sum + rs.sum, r.count + rs.count};
         // The 95th percentile (nearest rank) of the gathered values and the largest principal Green-Lagrange
-        // strain (eq. 15; volumetric solids only, shells not yet): gathered in array order, so the same for
-        // any thread count.
+        // strain (eq. 15; for shells the in-plane strain at the Gauss points through the thickness,
+        // Shells::strain): gathered in array order, so the same for any thread count.
         std::vector<double> vm;
         double strain = 0.0;
         for (std::size_t s = 0; s < S.size(); ++s)
@@ -704,7 +704,10 @@ std::vector<double> ProbeSet::measure(const World& world) const {
             strain = std::max(strain, largest_principal_strain(S.F(s)));
           }
         for (std::size_t s = 0; s < Sh.size(); ++s)
-          if (in_set[P.body[Sh.at(s)]]) vm.push_back(Sh.von_mises(s));
+          if (in_set[P.body[Sh.at(s)]]) {
+            vm.push_back(Sh.von_mises(s));
+            strain = std::max(strain, Sh.strain(s));
+          }
         out.insert(out.end(), {all.max, all.count > 0 ? all.sum / all.count : 0.0,
                                percentile_nearest_rank(vm, 95.0), strain});
         if (pr.per_body) {

@@ -189,6 +189,7 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
   F0_.assign(n, Mat3::Identity());
   energy_.assign(n, 0.0);
   vm_.assign(n, 0.0);
+  strain_.assign(n, 0.0);
   Nres_.assign(n, Mat2::Zero());
   Mres_.assign(n, Mat2::Zero());
   Qres_.assign(n, Eigen::Vector2d::Zero());
@@ -227,7 +228,7 @@ void Shells::update(const Particles& P) {
     Q0 << T1_[s], T2_[s], N_[s];
     Mat32 PG = Mat32::Zero(), PH = Mat32::Zero();
     Vec3 q = Vec3::Zero();
-    double U = 0.0, vm = 0.0;
+    double U = 0.0, vm = 0.0, strain = -1e300;
     Mat2 Nr = Mat2::Zero(), Mr = Mat2::Zero();
     Eigen::Vector2d Qr = Eigen::Vector2d::Zero();
     const double* xi = sp.neo_hookean ? kXi3 : kXi2;
@@ -243,6 +244,8 @@ void Shells::update(const Particles& P) {
       const double V = vol_[kGauss * s + k];
       U += V * psi;
       vm = std::max(vm, von_mises_plane(Sl));
+      const double em = 0.5 * (El(0, 0) + El(1, 1)), ed = 0.5 * (El(0, 0) - El(1, 1));
+      strain = std::max(strain, em + std::sqrt(ed * ed + El(0, 1) * El(0, 1)));
       // Resultants per unit length: the through-thickness integrals of S (sum of w_k t/2 S).
       const double wt = V / area_[s];
       Nr += wt * Sl.topLeftCorner<2, 2>();
@@ -260,6 +263,7 @@ void Shells::update(const Particles& P) {
     q_[s] = q;
     energy_[s] = U;
     vm_[s] = vm;
+    strain_[s] = strain;
     Nres_[s] = Nr;
     Mres_[s] = Mr;
     Qres_[s] = Qr;

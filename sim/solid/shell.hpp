@@ -112,6 +112,9 @@ class Shells {
   // Internal force of the last update() on slot s [N] (what add_forces() adds).
   const Vec3& internal_force(std::size_t s) const { return force_[s]; }
   double von_mises(std::size_t s) const { return vm_[s]; }
+  // Largest principal in-plane Green-Lagrange strain of the last update() over the particle's Gauss points
+  // through the thickness (the surfaces carry the bending strain).
+  double strain(std::size_t s) const { return strain_[s]; }
   // Resultants per unit reference length in the particle's reference tangent frame (T1, T2, N):
   // membrane force N [N/m], moment M [N m / m], transverse shear force Q [N/m] (PK2 through the thickness).
   const Mat2& membrane(std::size_t s) const { return Nres_[s]; }
@@ -181,7 +184,7 @@ class Shells {
   std::vector<Mat32> G_, H_, PG_, PH_;
   std::vector<Vec3> q_, hg_force_, force_, torque_;
   std::vector<Mat3> F0_;
-  std::vector<double> energy_, vm_;
+  std::vector<double> energy_, vm_, strain_;
   std::vector<Mat2> Nres_, Mres_;
   std::vector<Eigen::Vector2d> Qres_;
 };
