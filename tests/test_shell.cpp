@@ -342,7 +342,7 @@ TEST_CASE("shell: a cantilever strip's first frequency is Euler-Bernoulli's, and
 }
 
 TEST_CASE("shell: a strip periodic across its width bends cylindrically, as the plane-strain plate",
-          "[shell][periodic]") {
+          "[shell][periodic][heavy]") {
   // The plate of O'Connor & Rogers 2021 (scenes/shell_hydrostatic_fsi.json) without its water: L = 1 m
   // between the clamped end rows (x = 0 and L), t = 0.05 m, aluminium, a uniform 20.9 kPa load (the 2 m
   // column plus the plate's weight), periodic in z across a slab 16 spacings wide. Cylindrical bending:

@@ -457,7 +457,7 @@ std::pair<double, int> leaflet_gap(const Particles& P, double dx) {
 TEST_CASE(
     "shell leaflets: shell contact closes the valve under 80 mmHg at the barrier's gap, without it the "
     "leaflets pass through each other",
-    "[shell_leaflet][shell_contact]") {
+    "[shell_leaflet][shell_contact][heavy]") {
   // scenes/shell_valve_closed.json (no fluid, no wall): three neo-Hookean leaflets, 0.45 mm, closed in the
   // mirror shape Delta x apart, loaded on their aortic side by 10.7 kPa ramped over 6 ms and damped to rest.
   // Contact K = 1e6 Pa: two sheets at the pressure p rest at d_c K / (K + p), d_c = 1.5 t = 0.675 mm.
