@@ -248,7 +248,7 @@ TEST_CASE("shell contact: 1 vs 2 threads bitwise identical", "[shell_contact][he
 }
 
 TEST_CASE(
-    "shell contact: a wall beyond a sheet's free edge, in its plane, is not in contact; a held particle "
+    "shell contact: a wall beyond a sheet's free edge, in its plane, is not in contact, and a held particle "
     "does not bound the step",
     "[shell_contact]") {
   // A 10 x 10 mm free sheet in the plane z = 0 whose +x edge row lies at x = 4.5 mm; a block of wall 1 mm
