@@ -10,6 +10,7 @@
 
 #include "cli_helpers.hpp"
 #include "geometry/aortic_root.hpp"
+#include "io/probes.hpp"
 #include "scene_loader.hpp"
 #include "solid/shell.hpp"
 #include "world.hpp"
@@ -436,24 +437,6 @@ TEST_CASE(
   CHECK(deflection(2) == Approx(deflection(0)).epsilon(0.05));
 }
 
-namespace {
-
-// The smallest distance between particles of different bodies, and the pairs closer than dx / 2.
-std::pair<double, int> leaflet_gap(const Particles& P, double dx) {
-  double best = 1e30;
-  int overlaps = 0;
-  for (std::size_t i = 0; i < P.size(); ++i)
-    for (std::size_t j = i + 1; j < P.size(); ++j) {
-      if (P.body[i] == P.body[j]) continue;
-      const double d = (P.x[i] - P.x[j]).norm();
-      best = std::min(best, d);
-      overlaps += d < 0.5 * dx;
-    }
-  return {best, overlaps};
-}
-
-}  // namespace
-
 TEST_CASE(
     "shell leaflets: shell contact closes the valve under 80 mmHg at the barrier's gap, without it the "
     "leaflets pass through each other",
@@ -462,22 +445,28 @@ TEST_CASE(
   // mirror shape Delta x apart, loaded on their aortic side by 10.7 kPa ramped over 6 ms and damped to rest.
   // Contact K = 1e6 Pa: two sheets at the pressure p rest at d_c K / (K + p), d_c = 1.5 t = 0.675 mm.
   const std::string file = std::string(AORTASPH_TEST_DIR) + "/../scenes/shell_valve_closed.json";
-  const double dx = 0.001, dc = 1.5 * 0.00045, rest = dc * 1e6 / (1e6 + 10700.0);
+  const double dc = 1.5 * 0.00045, rest = dc * 1e6 / (1e6 + 10700.0);
   for (const bool contact : {true, false}) {
     Scene s = load_scene(file, {}).scene;
     if (!contact) s.contact.shell_stiffness = 0.0;
     World w(s);
-    double min_gap = 1e30;
+    // The scene's own probes: `gap` (.min, the smallest leaflet-leaflet distance; .overlaps, the pairs of
+    // different leaflets closer than dx / 2) and `stress`.
+    const ProbeSet probes(s, w);
+    REQUIRE(probes.columns().size() >= 3);
+    REQUIRE(probes.columns()[0] == "gap.min");
+    REQUIRE(probes.columns()[1] == "gap.overlaps");
+    REQUIRE(probes.columns()[2] == "stress.max");
+    double min_gap = 1e30, final_gap = 0.0, vm = 0.0;
     int overlaps = 0;
     for (int k = 1; k <= 24; ++k) {
       w.advance_to(0.0005 * k, [] { return true; });
-      const auto [g, o] = leaflet_gap(w.particles(), dx);
-      min_gap = std::min(min_gap, g);
-      overlaps += o;
+      const std::vector<double> v = probes.measure(w);
+      min_gap = std::min(min_gap, v[0]);
+      overlaps += static_cast<int>(v[1]);
+      final_gap = v[0];
+      vm = v[2];
     }
-    const double final_gap = leaflet_gap(w.particles(), dx).first;
-    double vm = 0.0;
-    for (std::size_t q = 0; q < w.shells().size(); ++q) vm = std::max(vm, w.shells().von_mises(q));
     INFO((contact ? "with" : "without")
          << " contact: smallest leaflet-leaflet distance over the run " << min_gap * 1e3 << " mm, at 12 ms "
          << final_gap * 1e3 << " mm (barrier's rest gap " << rest * 1e3 << " mm), pairs closer than "
