@@ -114,11 +114,12 @@ TEST_CASE("shell leaflets: one layer on the mid-surface, normals, areas and clam
           for (std::size_t j = i + 1; j < s.points.size(); ++j)
             closest = std::min(closest, (s.points[j] - s.points[i]).norm());
         CHECK(closest > 0.5 * dx);
-        // Areas: positive, summing to the mid-surface's area.
+        // Areas: positive, those of the leaflet proper (not the row embedded in the wall) summing to the
+        // mid-surface's area.
         double sum = 0.0, smallest = 1e300;
-        for (double a : s.areas) {
-          sum += a;
-          smallest = std::min(smallest, a);
+        for (std::size_t i = 0; i < s.areas.size(); ++i) {
+          if (s.clamped[i] != 2) sum += s.areas[i];
+          smallest = std::min(smallest, s.areas[i]);
         }
         const double A = mid_surface_area(root, k, dx);
         WARN((mirrored ? "mirror" : "labrosse")
@@ -129,21 +130,34 @@ TEST_CASE("shell leaflets: one layer on the mid-surface, normals, areas and clam
         CHECK(sum == Approx(A).epsilon(0.04));
         // Clamped attachment row: about one particle per dx along the attachment, all of them within dx of
         // the lumen surface; the rest free.
-        std::size_t held = 0;
+        // The embedded row: about one particle per dx along the attachment as well, each within a spacing
+        // of the lumen surface, outside it for the mirror leaflets (in the wall); Labrosse's leaflets meet
+        // the wall almost tangentially, so theirs lies along it, under half a spacing inside.
+        std::size_t held = 0, embedded = 0;
         for (std::size_t i = 0; i < s.points.size(); ++i) {
           if (!s.clamped[i]) continue;
-          ++held;
           const Vec3 q = s.points[i] - p.base;
           const double th = std::atan2(-q.z(), q.x()), rr = std::hypot(q.x(), q.z());
-          CHECK((root.lumen_radius(q.y(), th) - rr) / root.normal_scale(q.y(), th) < 1.0 * dx);
+          const double depth = (root.lumen_radius(q.y(), th) - rr) / root.normal_scale(q.y(), th);
+          CHECK(depth < 1.0 * dx);
+          if (s.clamped[i] == 2) {
+            ++embedded;
+            CHECK(depth < (mirrored ? 0.0 : 0.5 * dx));
+            CHECK(depth > -1.0 * dx);
+          } else {
+            ++held;
+            CHECK(depth > 0.0);
+          }
         }
         const double att = attachment_length(root, k);
         CHECK(held > 0.7 * att / dx);
         CHECK(held < 2.0 * att / dx);
-        CHECK(s.points.size() - held > 5 * held);
+        CHECK(embedded > 0.7 * att / dx);
+        CHECK(embedded < 1.3 * att / dx);
+        CHECK(s.points.size() - held - embedded > 5 * held);
       }
       // Gaps: neighbouring leaflets' particles at least 0.9 dx apart (dx across the coaptation planes), and
-      // from the wall's particles at least 0.85 dx.
+      // from the wall's particles more than half a spacing (the embedded rows too: the wall makes room).
       double between = 1e300, to_wall = 1e300;
       for (int a = 0; a < 3; ++a)
         for (int b = a + 1; b < 3; ++b)
@@ -234,15 +248,17 @@ TEST_CASE("shell leaflets: commissure posts clamp the leaflets there and leave n
   const AorticRoot plain(no_post);
   CHECK(plain.post_points(dx).empty());
   SurfaceMesh mesh;
-  CHECK(root.wall_points(dx, &mesh).size() == plain.wall_points(dx, nullptr).size() + post.size());
+  const std::vector<Vec3> wall = root.wall_points(dx, &mesh);
+  REQUIRE(wall.size() > post.size());
+  CHECK(std::equal(post.begin(), post.end(), wall.end() - static_cast<std::ptrdiff_t>(post.size())));
   // Leaflet particles within h of a commissure are clamped (more than without the post), and the post keeps
   // half a spacing from them.
   std::size_t clamped = 0, clamped_plain = 0;
   for (int k = 0; k < 3; ++k) {
     const ShapeSample s0 = plain.leaflet_shell(k, dx);
+    for (const uint8_t c : s0.clamped) clamped_plain += c == 1;
     for (std::size_t i = 0; i < l[k].points.size(); ++i) {
-      clamped += l[k].clamped[i];
-      clamped_plain += s0.clamped[i];
+      clamped += l[k].clamped[i] == 1;
       for (int c = 0; c < 3; ++c)
         if ((l[k].points[i] - p.base - root.commissure_point(c)).norm() < h) CHECK(l[k].clamped[i] == 1);
       for (const Vec3& q : post) CHECK((q - l[k].points[i]).norm() >= 0.5 * dx);

@@ -399,6 +399,19 @@ std::vector<Vec3> AorticRoot::wall_points(double dx, SurfaceMesh* mesh) const {
     }
   }
 
+  // Shell leaflets: the embedded rows (leaflet_shell) take the place of the wall particles within 0.55 dx
+  // of them (the leaflet's tissue inserts into the wall there).
+  if (p_.shell_leaflets) {
+    std::vector<Vec3> sheet;
+    for (int k = 0; k < 3; ++k)
+      for (const Vec3& q : leaflet_shell(k, dx).points) sheet.push_back(q);
+    const double r2 = 0.55 * 0.55 * dx * dx;
+    std::erase_if(out, [&](const Vec3& w) {
+      return std::any_of(sheet.begin(), sheet.end(),
+                         [&](const Vec3& q) { return (q - w).squaredNorm() < r2; });
+    });
+  }
+
   // Commissure posts (shell leaflets): wall particles between the leaflets below each commissure.
   if (p_.commissure_post_length() > 0.0)
     for (const Vec3& q : post_points(dx)) out.push_back(q);
@@ -435,7 +448,8 @@ std::vector<Vec3> AorticRoot::wall_points(double dx, SurfaceMesh* mesh) const {
 // Leaflets
 
 void AorticRoot::leaflet_mid_surface(int k, double dx, std::vector<Vec3>& mids, std::vector<Vec3>& normals,
-                                     std::vector<double>* areas, std::vector<int>* row_of) const {
+                                     std::vector<double>* areas, std::vector<int>* row_of,
+                                     bool embedded) const {
   // The sheet is built on the surface inset by half a spacing from both coaptation planes, so its free edges
   // lie dx/2 from them and the neighbouring leaflet's particles are dx away across each plane.
   const double inset = 0.5 * dx;
@@ -494,6 +508,18 @@ void AorticRoot::leaflet_mid_surface(int k, double dx, std::vector<Vec3>& mids, 
     const double from_att = kFirstRow * dx + i * (L - kFirstRow * dx) / (rows - 1);
     return rho_at(mc, L - from_att);
   };
+  // The point at arc length c from the attachment along meridian s; c < 0: beyond the attachment, on the
+  // meridian's tangent there (into the wall).
+  auto merid_point = [&](double s, double c) -> Vec3 {
+    const std::vector<double>& mc = meridian_at(s);
+    if (c >= 0.0) return surface_at(rho_at(mc, mc.back() - c), s);
+    const Vec3 a = surface_at(1.0, s), b = surface_at(1.0 - 1e-3, s);
+    return a - c * (a - b).normalized();
+  };
+  // Row i's point on meridian s (row -1: the embedded row, (1 - kFirstRow) dx beyond the attachment).
+  auto row_point = [&](int i, double s) {
+    return i >= 0 ? surface_at(row_rho(i, s), s) : merid_point(s, -(1.0 - kFirstRow) * dx);
+  };
 
   // Mid-surface points with their normals, row by row, equally spaced by arc length along each row.
   mids.clear();
@@ -501,12 +527,12 @@ void AorticRoot::leaflet_mid_surface(int k, double dx, std::vector<Vec3>& mids, 
   if (areas) areas->clear();
   if (row_of) row_of->clear();
   const int arc_samples = 128;
-  for (int i = 0; i < rows; ++i) {
+  for (int i = embedded ? -1 : 0; i < rows; ++i) {
     std::vector<double> ss(arc_samples + 1), cl(arc_samples + 1);
     Vec3 prev = Vec3::Zero();
     for (int a = 0; a <= arc_samples; ++a) {
       ss[a] = static_cast<double>(a) / arc_samples;
-      const Vec3 q = surface_at(row_rho(i, ss[a]), ss[a]);
+      const Vec3 q = row_point(i, ss[a]);
       cl[a] = a == 0 ? 0.0 : cl[a - 1] + (q - prev).norm();
       prev = q;
     }
@@ -528,12 +554,13 @@ void AorticRoot::leaflet_mid_surface(int k, double dx, std::vector<Vec3>& mids, 
     }
     for (int m = 0; m < n; ++m) {
       const double s = row_s[m];
-      const double rho = row_rho(i, s);
-      // Normal from the surface's tangents (at the apex, from just beside it).
-      const double rn = std::max(rho, 1e-3), e = 1e-6;
+      // Normal from the surface's tangents (at the apex, from just beside it; the embedded row: at the
+      // attachment).
+      const double e = 1e-6, rho = i >= 0 ? row_rho(i, s) : 1.0 - e;
+      const double rn = std::max(rho, 1e-3);
       const Vec3 d_rho = surface_at(rn + e, s) - surface_at(rn, s);
       const Vec3 d_s = surface_at(rn, s + e) - surface_at(rn, s - e);
-      mids.push_back(surface_at(rho, s));
+      mids.push_back(row_point(i, s));
       normals.push_back(d_rho.cross(d_s).normalized());
       if (row_of) row_of->push_back(i);
       if (!areas) continue;
@@ -544,12 +571,18 @@ void AorticRoot::leaflet_mid_surface(int k, double dx, std::vector<Vec3>& mids, 
       // 2 x 2 grid of flat quads on the surface.
       const double s_lo = m == 0 ? 0.0 : 0.5 * (row_s[m - 1] + s),
                    s_hi = m == n - 1 ? 1.0 : 0.5 * (s + row_s[m + 1]);
+      // The embedded row's cell: the spacing beyond the attachment line.
       auto cell_point = [&](double sc, double v) {
         const std::vector<double>& mc = meridian_at(sc);
         const double L = mc.back(), h = (L - kFirstRow * dx) / (rows - 1);
         const double c = kFirstRow * dx + i * h;
-        const double lo = i == 0 ? 0.0 : c - 0.5 * h, hi = i == rows - 1 ? L : c + 0.5 * h;
-        return surface_at(rho_at(mc, L - (lo + v * (hi - lo))), sc);
+        const double lo = i < 0    ? -dx
+                          : i == 0 ? 0.0
+                                   : c - 0.5 * h,
+                     hi = i < 0           ? 0.0
+                          : i == rows - 1 ? L
+                                          : c + 0.5 * h;
+        return merid_point(sc, lo + v * (hi - lo));
       };
       Vec3 g[3][3];
       const double su[3] = {s_lo, s, s_hi};
@@ -623,7 +656,7 @@ ShapeSample AorticRoot::leaflet_shell(int k, double dx) const {
   std::vector<Vec3> mids, normals;
   std::vector<double> areas;
   std::vector<int> row_of;
-  leaflet_mid_surface(k, dx, mids, normals, &areas, &row_of);
+  leaflet_mid_surface(k, dx, mids, normals, &areas, &row_of, true);
   // One orientation over the whole sheet: d_rho x d_s keeps its side on the regular (rho, s) patch; its sign
   // is chosen so that the normal mid-belly points up the root (from the ventricle to the aorta).
   const double e = 1e-6, inset = 0.5 * dx;
@@ -638,20 +671,25 @@ ShapeSample AorticRoot::leaflet_shell(int k, double dx) const {
     const double r = std::hypot(q.x(), q.z()), th = std::atan2(-q.z(), q.x());
     double s = 0.0;
     const double depth = (lumen_radius(q.y(), th) - r) / normal_scale(q.y(), th);
+    // Commissure posts: the leaflets are attached to each other and to the wall within the post's distance
+    // of a commissure (the tissue is continuous there in a real root).
+    bool post = false;
+    for (int c = 0; c < 3 && post_len > 0.0; ++c) post = post || (q - commissure_point(c)).norm() < post_len;
+    // The embedded row (row -1) is the leaflet's tissue inside the wall: it closes the gap between the
+    // first row and the wall's first layer, through which blood sliding along the wall passed round the
+    // attachment (docs/model.md). None within a post (the post's wall particles are there).
+    const bool embedded = row_of[m] < 0;
     if (sector_of(th, s) != k || sector_distance(r, s * dphi_[k], dphi_[k]) < kSectorMargin * dx ||
-        depth < kShellWallMargin * dx || q.y() < -p_.lvot_length + 0.5 * dx) {
-      dropped.push_back(m);
+        (!embedded && depth < kShellWallMargin * dx) || (embedded && post) ||
+        q.y() < -p_.lvot_length + 0.5 * dx) {
+      if (!embedded) dropped.push_back(m);
       continue;
     }
     kept.push_back(m);
     out.points.push_back(p_.base + q);
     out.normals.push_back(sign * normals[m]);
     out.areas.push_back(areas[m]);
-    // Commissure posts: the leaflets are attached to each other and to the wall within the post's distance
-    // of a commissure (the tissue is continuous there in a real root).
-    bool post = false;
-    for (int c = 0; c < 3 && post_len > 0.0; ++c) post = post || (q - commissure_point(c)).norm() < post_len;
-    out.clamped.push_back(row_of[m] == 0 || depth < kShellClampDepth * dx || post ? 1 : 0);
+    out.clamped.push_back(embedded ? 2 : row_of[m] == 0 || depth < kShellClampDepth * dx || post ? 1 : 0);
   }
   // A point left out hands its area to the nearest kept point, so the areas still tile the mid-surface.
   for (std::size_t m : dropped) {

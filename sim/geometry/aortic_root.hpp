@@ -189,9 +189,10 @@ class AorticRoot {
   // particles.
   std::vector<Vec3> blood_lattice(double dx) const;
   // Leaflet k's mid-surface points (root frame, relative to base), row by row, with the unit normals
-  // d_rho x d_s (not oriented) and, if asked, the surface element of each point.
+  // d_rho x d_s (not oriented) and, if asked, the surface element of each point. With `embedded`, a row -1
+  // half a spacing beyond the attachment line, into the wall (shell leaflets: see leaflet_shell).
   void leaflet_mid_surface(int k, double dx, std::vector<Vec3>& mids, std::vector<Vec3>& normals,
-                           std::vector<double>* areas, std::vector<int>* row_of) const;
+                           std::vector<double>* areas, std::vector<int>* row_of, bool embedded = false) const;
   double bump(int k, double s, double y) const;
   // Mirror leaflets: signed distance of x (root frame) from leaflet k's attachment plane (positive on the
   // aortic side), the reflection across it, and the closed surface's height above (x, z).

@@ -14,7 +14,9 @@ struct ShapeSample {
   std::vector<Vec3> points;  // particle centres, world coordinates, lexicographic lattice order
   SurfaceMesh mesh;          // surface for rendering, world coordinates
   // Empty, or one flag per point: 1 = clamped by the shape itself (the aortic leaflets' rows along their
-  // attachment to the wall). Elastic solvers treat these like the body's `fixed` region.
+  // attachment to the wall; 2 = clamped and embedded in the wall: a shell leaflet's row beyond its attachment
+  // line, where the wall's particles make room for it). Elastic solvers treat these like the body's `fixed`
+  // region.
   std::vector<uint8_t> clamped;
   // Shell shapes (rectangle, disc, cylindrical_panel): per point the unit normal of the mid-surface and the
   // area the particle stands for; pinned like clamped, position only (a disc's pinned rim).
