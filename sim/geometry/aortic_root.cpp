@@ -652,6 +652,18 @@ std::vector<Vec3> AorticRoot::leaflet_points(int k, double dx, std::vector<uint8
 }
 
 ShapeSample AorticRoot::leaflet_shell(int k, double dx) const {
+  {
+    const std::lock_guard<std::mutex> lock(shell_cache_->m);
+    const auto it = shell_cache_->sheets.find({k, dx});
+    if (it != shell_cache_->sheets.end()) return it->second;
+  }
+  ShapeSample out = leaflet_shell_uncached(k, dx);
+  const std::lock_guard<std::mutex> lock(shell_cache_->m);
+  shell_cache_->sheets.emplace(std::make_pair(k, dx), out);
+  return out;
+}
+
+ShapeSample AorticRoot::leaflet_shell_uncached(int k, double dx) const {
   ShapeSample out;
   std::vector<Vec3> mids, normals;
   std::vector<double> areas;

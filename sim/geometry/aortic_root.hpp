@@ -96,6 +96,9 @@
 // tables were not at hand here, so the ratio is taken as quoted).
 #pragma once
 
+#include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -185,6 +188,7 @@ class AorticRoot {
 
  private:
   double midline_length(double sag) const;
+  ShapeSample leaflet_shell_uncached(int k, double dx) const;
   // The blood lattice (see blood_points), less the commissure posts' region and 0.75 dx round their
   // particles.
   std::vector<Vec3> blood_lattice(double dx) const;
@@ -208,6 +212,13 @@ class AorticRoot {
   Vec3 plane_n_[3], plane_p_[3];       // mirror leaflets: attachment planes (unit normal, a point)
   std::vector<double> attachment_[3];  // mirror leaflets: attachment height at s = i / (size - 1)
   double lean_ = 0.0;                  // mirror leaflets: dr/dy of the open surface's lines (open_radius)
+  // leaflet_shell by (k, dx): the wall (the embedded rows, the posts) and the blood (their gaps) each ask for
+  // the three sheets, which are costly to sample (mirror leaflets: bisections per surface point).
+  struct ShellCache {
+    std::mutex m;
+    std::map<std::pair<int, double>, ShapeSample> sheets;
+  };
+  std::shared_ptr<ShellCache> shell_cache_ = std::make_shared<ShellCache>();
 };
 
 // Thin-leaflet scaling. A real leaflet is about t = 0.4 mm thick; the particle leaflet is layers x dx thick
