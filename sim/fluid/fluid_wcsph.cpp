@@ -161,7 +161,10 @@ inline Vec3 local_wall_term(const FluidContext& ctx, const PairConstants& c, con
   const Vec3 gradW = (dwdr / r) * r_ig;
   const double pg = std::max(I.p + I.rho * g_minus_a.dot(-r_ig), 0.0);
   const double rhog = fi.density(pg);
-  double scalar = -(I.p_over_rho2 + pg / (rhog * rhog));
+  // The wall pushes and never pulls: i's own pressure enters cut at zero as well. With i in tension (p_i < 0:
+  // behind an opening leaflet, in a vortex's core) the term -p_i / rho_i^2 drew i onto the imaginary wall and
+  // through the sheet (docs/validation.md, stop 31). Unchanged wherever p_i >= 0.
+  double scalar = -(std::max(I.p, 0.0) / (I.rho * I.rho) + pg / (rhog * rhog));
   if (fi.alpha > 0.0) {
     const double vx = vij.dot(r_ig);
     if (vx < 0.0) scalar += fi.alpha * fi.c0 * (c.h * vx / (r2 + c.eta2)) / (0.5 * (I.rho + rhog));
