@@ -430,7 +430,11 @@ void World::step(double dt) {
   // Transport velocity (Adami et al. 2013): v~ - v from the positions now, before the forces (its stress
   // term enters them).
   if (transport_) fluid_transport_velocity(P_, nb_, ctx, dt, ctx.transport_dv);
-  fluid_forces(P_, nb_, ctx);  // eqs. (9), (10), artificial viscosity, gravity
+  // eqs. (9), (10), artificial viscosity, gravity; and the particle shifting (Lind et al. 2012) for this
+  // step, its sums carried by the same neighbour loop (applied in integrate). Bodies move after this (rigid
+  // bodies in step_rigid, shells in step_shells): the shift sees their positions at t, as the forces do.
+  const ShiftRequest shift{scene_.spacing, dt, &shift_};
+  fluid_forces(P_, nb_, ctx, shifting_ ? &shift : nullptr);
   profile_.forces += seconds_since(t0);
 
   // Forces on body particles from the fluid and from contact (eqs. 23-25).
@@ -448,7 +452,6 @@ void World::step(double dt) {
   profile_.rigid += seconds_since(t0);
 
   t0 = Clock::now();
-  if (shifting_) fluid_shifting(P_, nb_, ctx_, scene_.spacing, dt, shift_);  // Lind et al. 2012
   integrate(dt);
   if (coupling_.active()) coupling_.guard(P_, ctx_.periodic);  // no fluid particle through a sheet
   profile_.integrate += seconds_since(t0);

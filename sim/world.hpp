@@ -126,6 +126,7 @@ class World {
   const Scene& scene() const { return scene_; }
   const Particles& particles() const { return P_; }
   const NeighborSearch& neighbors() const { return nb_; }
+  const FluidContext& fluid_context() const { return ctx_; }
   const std::vector<BodyInfo>& bodies() const { return bodies_; }
   const std::vector<RigidBody>& rigid_bodies() const { return rigid_; }
   const Solids& solids() const { return solids_; }

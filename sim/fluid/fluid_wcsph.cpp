@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/parallel.hpp"
+#include "fluid/shifting.hpp"
 
 namespace aortasph {
 
@@ -304,22 +305,42 @@ inline Vec3 local_wall_term(const FluidContext& ctx, const PairConstants& c, con
 
 }  // namespace
 
-void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ctx) {
+void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ctx,
+                  const ShiftRequest* shift) {
   const auto& idx = nb.index();
   const PairConstants c(ctx.kernel);
+  const double w_dx = shift ? ctx.kernel.W(shift->dx) : 0.0;
+  if (shift) shift->out->assign(P.size(), Vec3::Zero());
   parallel_for_dynamic(P.size(), [&](std::size_t i) {
     if (P.kind[i] != Kind::Fluid) return;
     const FluidI I(P, ctx, i);
+    const double A = shift ? I.params->shifting : 0.0;
     Vec3 acc = Vec3::Zero();
+    ShiftSums sums;
+    // Particle shifting's sums over the same neighbours, in the same order (fluid/shifting.hpp).
+    auto add_shift = [&](uint32_t j) {
+      const Vec3 xij = ctx.separation(I.x, P.x[j]);
+      const double r2 = xij.squaredNorm();
+      if (r2 < c.support2 && r2 > 0.0) sums.add(ctx.kernel, w_dx, xij, r2, P.m[j] / P.rho[j]);
+    };
     const uint32_t end = nb.end(i);
     const uint32_t local = ctx.shell_wall ? std::min(end, ctx.shell_wall->local_begin[i]) : end;
-    for (uint32_t k = nb.begin(i); k < local; ++k) acc += pair_acceleration(P, ctx, c, I, idx[k]);
+    if (A > 0.0) {
+      for (uint32_t k = nb.begin(i); k < local; ++k) {
+        acc += pair_acceleration(P, ctx, c, I, idx[k]);
+        add_shift(idx[k]);
+      }
+    } else {
+      for (uint32_t k = nb.begin(i); k < local; ++k) acc += pair_acceleration(P, ctx, c, I, idx[k]);
+    }
     for (uint32_t k = local; k < end; ++k) {  // walls across a sheet (fluid/shell_wall.hpp)
       const uint32_t j = idx[k];
       acc += local_wall_term(ctx, c, I, ctx.separation(I.x, P.x[j]), P.m[j], I.v - P.v[j],
                              ctx.gravity - P.a[j], nullptr);
+      if (A > 0.0) add_shift(j);
     }
     P.a[i] = acc + ctx.gravity;
+    if (A > 0.0) (*shift->out)[i] = shift_from(sums, A, ctx.kernel.h, I.v.norm(), shift->dt, shift->dx);
   });
 }
 

@@ -98,7 +98,15 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
 
 // Acceleration of every fluid particle: pressure (eq. 9), viscosity (eq. 10), artificial viscosity, gravity.
 // Gathers: each fluid particle writes only its own a.
-void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ctx);
+// With `shift` (World::step, where a material shifts): the particle shifting of fluid/shifting.hpp for a
+// step of dt at spacing dx, its sums carried by the same neighbour loop (bitwise the stand-alone
+// fluid_shifting's at the same positions), written to (*shift)[i].
+struct ShiftRequest {
+  double dx = 0.0, dt = 0.0;
+  std::vector<Vec3>* out = nullptr;
+};
+void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ctx,
+                  const ShiftRequest* shift = nullptr);
 
 // Adds to f[j], for every moving boundary particle j (rigid, elastic), the force the fluid exerts on it:
 // minus the sum of m_i a_ij over its fluid neighbours i, with the very pair terms of fluid_forces (Newton's

@@ -19,14 +19,36 @@
 // untouched, so they stay conserved exactly.
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include "fluid/fluid_wcsph.hpp"
 
 namespace aortasph {
 
+// The per-particle sums of the shift, grad C_i and div r_i, one neighbour at a time (so that the force loop
+// can carry them: fluid_forces), and the shift they give.
+struct ShiftSums {
+  Vec3 grad_c = Vec3::Zero();
+  double div_r = 0.0;
+  // Neighbour j at x_ij = x_i - x_j (|x_ij|^2 = r2, inside the support), volume V_j = m_j / rho_j;
+  // w_dx = W(dx).
+  void add(const CubicSpline& K, double w_dx, const Vec3& xij, double r2, double vj) {
+    constexpr double R = 0.2;
+    const double r = std::sqrt(r2);
+    const Vec3 grad_w = (K.dWdr(r) / r) * xij;
+    const double q = K.W(r) / w_dx;
+    grad_c += (vj * (1.0 + R * q * q * q * q)) * grad_w;
+    div_r -= vj * grad_w.dot(xij);
+  }
+};
+// The shift of a particle with coefficient A, speed |v|, for a step of dt (the surface rule and the cap).
+Vec3 shift_from(const ShiftSums& s, double A, double h, double speed, double dt, double dx);
+
 // Shift of every fluid particle whose material has shifting > 0 (zero for the others), from the positions
-// and velocities now, for a step of dt. Gathers: each particle writes only its own entry.
+// and velocities now, for a step of dt. Gathers: each particle writes only its own entry. (World::step has
+// fluid_forces carry the same sums in its neighbour loop instead: one pass fewer; this stand-alone pass is
+// the reference the test compares it with.)
 void fluid_shifting(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx, double dx,
                     double dt, std::vector<Vec3>& shift);
 
