@@ -689,7 +689,7 @@ ShapeSample AorticRoot::leaflet_shell_uncached(int k, double dx) const {
     for (int c = 0; c < 3 && post_len > 0.0; ++c) post = post || (q - commissure_point(c)).norm() < post_len;
     // The embedded row (row -1) is the leaflet's tissue inside the wall: it closes the gap between the
     // first row and the wall's first layer, through which blood sliding along the wall passed round the
-    // attachment (docs/model.md). None within a post (the post's wall particles are there).
+    // attachment (docs/scenes.md, "Embedded row"). None within a post (the post's wall particles are there).
     const bool embedded = row_of[m] < 0;
     if (sector_of(th, s) != k || sector_distance(r, s * dphi_[k], dphi_[k]) < kSectorMargin * dx ||
         (!embedded && depth < kShellWallMargin * dx) || (embedded && post) ||
