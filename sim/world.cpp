@@ -9,7 +9,6 @@
 #include "boundary/boundary.hpp"
 #include "core/parallel.hpp"
 #include "core/sim_errors.hpp"
-#include "fluid/shifting.hpp"
 #include "fluid/transport_velocity.hpp"
 #include "geometry/shapes.hpp"
 
