@@ -403,8 +403,11 @@ std::vector<Vec3> AorticRoot::wall_points(double dx, SurfaceMesh* mesh) const {
   // of them (the leaflet's tissue inserts into the wall there).
   if (p_.shell_leaflets) {
     std::vector<Vec3> sheet;
-    for (int k = 0; k < 3; ++k)
-      for (const Vec3& q : leaflet_shell(k, dx).points) sheet.push_back(q);
+    for (int k = 0; k < 3; ++k) {
+      const ShapeSample l = leaflet_shell(k, dx);
+      for (std::size_t m = 0; m < l.points.size(); ++m)
+        if (l.clamped[m] == 2) sheet.push_back(l.points[m]);
+    }
     const double r2 = 0.55 * 0.55 * dx * dx;
     std::erase_if(out, [&](const Vec3& w) {
       return std::any_of(sheet.begin(), sheet.end(),
