@@ -8,6 +8,7 @@
 
 #include "builders.hpp"
 #include "core/parallel.hpp"
+#include "fluid/shifting.hpp"
 #include "world.hpp"
 
 using namespace aortasph;
@@ -339,4 +340,68 @@ TEST_CASE("shell-fluid: water passes round a free edge, not through the sheet be
   CHECK(passed > 30);
   CHECK(through == 0);
   CHECK(diff < 0.7 * diff0);
+}
+
+TEST_CASE("shell-fluid: particle shifting sees a sheet as a wall, fused and stand-alone equal",
+          "[shell_fluid]") {
+  // Water on both sides of a clamped sheet across a shaft, on the lattice, moving along the sheet at 0.5 m/s
+  // (the shift scales with the speed). The imaginary wall particles complete the support beside the sheet
+  // as a wall's layers do beside the shaft's floor: the kernel divergence of position div r (3 in the bulk,
+  // under 2.5 read as a free surface, fluid/shifting.hpp) and the concentration gradient there are those
+  // beside the floor. With the sheet's own particles in the sums (volume A t) the sheet was a hole in the
+  // support: the rows beside it were taken for a free surface and shifted along it only.
+  const double dx = 0.05, w = 0.6, y_sheet = 0.3;
+  Material m = water(20.0);
+  m.shifting = 2.0;
+  Scene s = tank_scene("shift_sheet", dx, Vec3(w, 0.7, w), 20.0, shell_sheet(1e7, 0.3, 0.01));
+  s.materials[0] = m;
+  s.gravity = Vec3::Zero();
+  const double top = y_sheet + 0.3;
+  s.bodies = {box_body("below", 0, Vec3(0, 0, 0), Vec3(w, y_sheet, w), Vec3(0.5, 0, 0)),
+              box_body("above", 0, Vec3(0, y_sheet, 0), Vec3(w, top, w), Vec3(0.5, 0, 0)),
+              container("shaft", 1, Vec3(0, 0, 0), Vec3(w, 0.7, w), {"+y"}),
+              clamped_sheet(2, w, y_sheet, dx)};
+  World world(s);
+  world.step(world.stable_dt());  // the coupling's labels and imaginary particles are built in a step
+  const double dt = world.stable_dt();
+  const Particles& P = world.particles();
+  const NeighborSearch& nb = world.neighbors();
+  const FluidContext& ctx = world.fluid_context();
+  std::vector<Vec3> ref, fused;
+  fluid_shifting(P, nb, ctx, dx, dt, ref);
+  Particles copy = P;
+  const ShiftRequest req{dx, dt, &fused};
+  fluid_forces(copy, nb, ctx, &req);
+  std::size_t differ = 0, moved = 0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    differ += fused[i] != ref[i];
+    moved += ref[i].norm() > 0.0;
+  }
+  CHECK(moved > 0);
+  CHECK(differ == 0);
+  // The sums of the rows within dx of the sheet and of the floor, away from the shaft's side walls (3 dx).
+  const double w_dx = ctx.kernel.W(dx);
+  double div_sheet = 1e30, div_floor = 1e30, grad_sheet = 0.0, grad_floor = 0.0;
+  int n_sheet = 0, n_floor = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.kind[i] != Kind::Fluid) continue;
+    const Vec3& x = P.x[i];
+    if (x.x() < 3 * dx || x.x() > w - 3 * dx || x.z() < 3 * dx || x.z() > w - 3 * dx) continue;
+    const bool sheet = std::abs(x.y() - y_sheet) < dx, floor = x.y() < dx;
+    if (!sheet && !floor) continue;
+    ShiftSums sums;
+    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k)
+      add_shift_neighbour(sums, P, ctx, w_dx, i, nb.index()[k], ctx.separation(x, P.x[nb.index()[k]]));
+    (sheet ? div_sheet : div_floor) = std::min(sheet ? div_sheet : div_floor, sums.div_r);
+    (sheet ? grad_sheet : grad_floor) = std::max(sheet ? grad_sheet : grad_floor, std::abs(sums.grad_c.y()));
+    ++(sheet ? n_sheet : n_floor);
+  }
+  INFO(n_sheet << " particles beside the sheet: smallest div r " << div_sheet << ", largest |dC/dy| "
+               << grad_sheet << " 1/m; " << n_floor << " beside the floor: " << div_floor << ", "
+               << grad_floor);
+  REQUIRE(n_sheet == 72);  // 6 x 6 on each side
+  REQUIRE(n_floor == 36);
+  CHECK(div_sheet > 2.5);  // not a free surface
+  CHECK(std::abs(div_sheet - div_floor) < 0.03 * div_floor);
+  CHECK(grad_sheet < grad_floor + 0.5);
 }

@@ -13,6 +13,7 @@ ShellCoupling::ShellCoupling(const Particles& P, const Shells& shells, double dx
   wall_.dx = dx;
   wall_.layers = static_cast<int>(std::floor(support / dx + 0.5));  // (k - 1/2) dx < support
   ghost_rho_ = rho_ref;
+  wall_.ghost_rho = rho_ref;
   // Edge particles: the first moment of the reference neighbourhood, sum_j W_ij (X_j - X_i) / sum_j W_ij,
   // vanishes inside a sheet and is about dx / 2 at its edge; over 0.1 dx flags the two or three rows along
   // every edge (only there is the exact patch test needed).

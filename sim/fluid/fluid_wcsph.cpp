@@ -319,9 +319,7 @@ void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ct
     ShiftSums sums;
     // Particle shifting's sums over the same neighbours, in the same order (fluid/shifting.hpp).
     auto add_shift = [&](uint32_t j) {
-      const Vec3 xij = ctx.separation(I.x, P.x[j]);
-      const double r2 = xij.squaredNorm();
-      if (r2 < c.support2 && r2 > 0.0) sums.add(ctx.kernel, w_dx, xij, r2, P.m[j] / P.rho[j]);
+      add_shift_neighbour(sums, P, ctx, w_dx, i, j, ctx.separation(I.x, P.x[j]));
     };
     const uint32_t end = nb.end(i);
     const uint32_t local = ctx.shell_wall ? std::min(end, ctx.shell_wall->local_begin[i]) : end;

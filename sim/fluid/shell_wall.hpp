@@ -49,8 +49,9 @@ struct ShellWall {
     uint8_t n = 0;
   };
   std::vector<Sides> sides;
-  double dx = 0.0;  // layer spacing
-  int layers = 0;   // K
+  double dx = 0.0;         // layer spacing
+  int layers = 0;          // K
+  double ghost_rho = 0.0;  // the imaginary particles' density: ghost_mass / ghost_rho is their volume A_j dx
 
   // The side sigma on which fluid particle i sees the sheet of body `body_j` near shell particle j: its
   // label for that body when it has one, otherwise the side of j's own tangent plane. The label, not the

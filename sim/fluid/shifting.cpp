@@ -25,7 +25,6 @@ void fluid_shifting(const Particles& P, const NeighborSearch& nb, const FluidCon
   shift.assign(P.size(), Vec3::Zero());
   const auto& idx = nb.index();
   const CubicSpline& K = ctx.kernel;
-  const double support2 = K.support * K.support;
   const double w_dx = K.W(dx);
   parallel_for_dynamic(P.size(), [&](std::size_t i) {
     if (P.kind[i] != Kind::Fluid) return;
@@ -35,10 +34,7 @@ void fluid_shifting(const Particles& P, const NeighborSearch& nb, const FluidCon
     ShiftSums sums;
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
-      const Vec3 xij = ctx.separation(xi, P.x[j]);
-      const double r2 = xij.squaredNorm();
-      if (r2 >= support2 || r2 <= 0.0) continue;
-      sums.add(K, w_dx, xij, r2, P.m[j] / P.rho[j]);
+      add_shift_neighbour(sums, P, ctx, w_dx, i, j, ctx.separation(xi, P.x[j]));
     }
     shift[i] = shift_from(sums, A, K.h, P.v[i].norm(), dt, dx);
   });
