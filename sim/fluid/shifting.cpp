@@ -7,6 +7,17 @@
 
 namespace aortasph {
 
+void add_shift_ghosts(ShiftSums& s, const Particles& P, const FluidContext& ctx, double w_dx, std::size_t i,
+                      uint32_t j, const Vec3& xij) {
+  const double support2 = ctx.kernel.support * ctx.kernel.support;
+  const ShellWall& sw = *ctx.shell_wall;
+  const double vg = sw.ghost_mass[j] / sw.ghost_rho;
+  sw.for_each_ghost(xij, i, j, P.body[j], [&](const Vec3& rg) {
+    const double rg2 = rg.squaredNorm();
+    if (rg2 < support2 && rg2 > 0.0) s.add(ctx.kernel, w_dx, rg, rg2, vg);
+  });
+}
+
 Vec3 shift_from(const ShiftSums& s, double A, double h, double speed, double dt, double dx) {
   if (s.div_r < 1.5) return Vec3::Zero();  // a splash: too few neighbours to tell disorder from emptiness
   Vec3 dr = -(A * h * speed * dt) * s.grad_c;

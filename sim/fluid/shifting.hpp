@@ -42,6 +42,9 @@ struct ShiftSums {
     div_r -= vj * grad_w.dot(xij);
   }
 };
+// The shell branch of add_shift_neighbour, out of line: only scenes with a shell beside a fluid reach it.
+[[gnu::noinline]] void add_shift_ghosts(ShiftSums& s, const Particles& P, const FluidContext& ctx,
+                                        double w_dx, std::size_t i, uint32_t j, const Vec3& xij);
 // Adds neighbour j of fluid particle i (x_ij = x_i - x_j) to i's sums, if inside the support. A shell
 // particle stands for its imaginary wall particles (fluid/shell_wall.hpp), each of volume A_j dx, on the far
 // side of the sheet from i: the concentration next to a sheet is then that next to a plain wall, and the
@@ -49,17 +52,9 @@ struct ShiftSums {
 // like a hole in i's support, and the shift pushed i into it).
 inline void add_shift_neighbour(ShiftSums& s, const Particles& P, const FluidContext& ctx, double w_dx,
                                 std::size_t i, uint32_t j, const Vec3& xij) {
-  const double support2 = ctx.kernel.support * ctx.kernel.support;
-  if (ctx.shell_wall && P.kind[j] == Kind::Shell) {
-    const ShellWall& sw = *ctx.shell_wall;
-    const double vg = sw.ghost_mass[j] / sw.ghost_rho;
-    sw.for_each_ghost(xij, i, j, P.body[j], [&](const Vec3& rg) {
-      const double rg2 = rg.squaredNorm();
-      if (rg2 < support2 && rg2 > 0.0) s.add(ctx.kernel, w_dx, rg, rg2, vg);
-    });
-    return;
-  }
+  if (ctx.shell_wall && P.kind[j] == Kind::Shell) return add_shift_ghosts(s, P, ctx, w_dx, i, j, xij);
   const double r2 = xij.squaredNorm();
+  const double support2 = ctx.kernel.support * ctx.kernel.support;
   if (r2 < support2 && r2 > 0.0) s.add(ctx.kernel, w_dx, xij, r2, P.m[j] / P.rho[j]);
 }
 
