@@ -12,7 +12,6 @@ ShellCoupling::ShellCoupling(const Particles& P, const Shells& shells, double dx
     : active_(!shells.empty()), dx_(dx), patch2_(0.64 * dx * dx) {
   wall_.dx = dx;
   wall_.layers = static_cast<int>(std::floor(support / dx + 0.5));  // (k - 1/2) dx < support
-  ghost_rho_ = rho_ref;
   wall_.ghost_rho = rho_ref;
   // Edge particles: the first moment of the reference neighbourhood, sum_j W_ij (X_j - X_i) / sum_j W_ij,
   // vanishes inside a sheet and is about dx / 2 at its edge; over 0.1 dx flags the two or three rows along
@@ -160,7 +159,7 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
   parallel_for(shells.size(), [&](std::size_t s) {
     const uint32_t i = shells.at(s);
     wall_.normal[i] = shells.director(s);
-    wall_.ghost_mass[i] = ghost_rho_ * shells.area(s) * dx_;
+    wall_.ghost_mass[i] = wall_.ghost_rho * shells.area(s) * dx_;
   });
   // Edge particles: the current outward direction in the tangent plane, minus the first moment of the
   // reference neighbours at their current positions.

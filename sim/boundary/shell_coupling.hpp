@@ -86,7 +86,7 @@ class ShellCoupling {
                        uint16_t body) const;
 
   bool active_ = false;
-  double dx_ = 0.0, patch2_ = 0.0, ghost_rho_ = 1000.0;
+  double dx_ = 0.0, patch2_ = 0.0;
   std::vector<uint8_t> edge_;  // by shell slot
   std::vector<uint8_t> rim_;   // by shell slot: the outermost row of an edge (ShellWall::cap)
   // Edge particles (slots), their reference neighbours (slots) with kernel weights (CSR), and by particle
