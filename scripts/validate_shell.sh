@@ -2,7 +2,8 @@
 # Shell validations too slow for the test suite (issue 16; results in docs/validation.md, "Shells"):
 #   - the classic clamped circular plate (scenes/shell_plate.json: a = 40 in, t = 1 in, p = 6 psi) at dx = 4t, 2t,
 #     t: centre deflection against p a^4 / (64 D) = 2.2189 mm;
-#   - the roll-up of a cantilever strip under an end moment 2 pi E I / L, and the Scordelis-Lo roof
+#   - the roll-up of a cantilever strip under an end moment 2 pi E I / L (free, and periodic across its width),
+#     the cantilever strip's energy over ten periods, and the Scordelis-Lo roof
 #     (tests/test_shell.cpp, hidden tag [.shell-validation]);
 #   - the hydrostatic water column on an aluminium plate of O'Connor & Rogers 2021 / Fourey et al. 2017
 #     (scenes/shell_hydrostatic_fsi.json, quasi-2-D, periodic in z): mid-span deflection, mean over 0.2-1 s,
