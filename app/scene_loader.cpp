@@ -231,7 +231,8 @@ class Loader {
     materials(top.raw("materials"), s);
     if (!top.has("contact")) root["contact"] = json::object();
     Obj con(top.raw("contact"), "contact",
-            {"stiffness", "damping", "shear", "friction", "shell_stiffness", "shell_margin", "shell_damping"},
+            {"stiffness", "damping", "shear", "friction", "shell_stiffness", "shell_margin", "shell_damping",
+             "shell_fluid_barrier"},
             allowed);
     s.contact.stiffness = con.non_negative("stiffness", 0.0);
     s.contact.damping = con.non_negative("damping", 0.0);
@@ -240,6 +241,7 @@ class Loader {
     s.contact.shell_stiffness = con.non_negative("shell_stiffness", 0.0);
     if (con.has("shell_margin")) s.contact.shell_margin = con.non_negative("shell_margin", 0.0);
     s.contact.shell_damping = con.non_negative("shell_damping", 0.5);
+    s.contact.shell_fluid_barrier = con.non_negative("shell_fluid_barrier", 1.0);
 
     // Geometry shared by the aortic_root shapes (each shape's own keys override it).
     if (top.has("aortic_root")) {

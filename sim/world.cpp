@@ -521,6 +521,14 @@ void World::body_forces() {
   fluid_reaction(P_, nb_, ctx_, force_);
   contact_forces(P_, nb_, contact_, force_, moment_);
   shell_contact_.add_forces(P_, nb_, shells_, ctx_.periodic, force_);  // sim/solid/shell_contact.hpp
+  // Fluid against a sheet's thickness: the fluid particle's share goes into its acceleration (after
+  // fluid_forces), the sheet's into force_.
+  if (coupling_.active() && scene_.contact.shell_fluid_barrier > 0.0) {
+    std::vector<double> K(fluid_.size(), 0.0);
+    for (std::size_t m = 0; m < fluid_.size(); ++m)
+      K[m] = scene_.contact.shell_fluid_barrier * fluid_[m].rho0 * fluid_[m].c0 * fluid_[m].c0;
+    coupling_.barrier(P_, shells_, ctx_.periodic, K, force_);
+  }
 }
 
 // Elastic particles: internal forces (eqs. 14-18 with their stabilisers) plus what body_forces() found (the

@@ -139,6 +139,12 @@ TEST_CASE("malformed scenes are refused with the JSON path", "[scene][bad-input]
        },
        {},
        "contact.stiffness"},
+      {"negative fluid barrier",
+       [](json& j) {
+         j["contact"] = {{"shell_fluid_barrier", -0.5}};
+       },
+       {},
+       "contact.shell_fluid_barrier"},
       {"cfl", [](json& j) { j["time"]["cfl"] = 2; }, {}, "time.cfl"},
       {"odd width",
        [](json& j) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/kernel.hpp"
 #include "core/parallel.hpp"
 
 namespace aortasph {
@@ -253,6 +254,70 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
   });
   masked_ = 0;
   for (const uint32_t m : masked) masked_ += m;
+}
+
+namespace {
+// The thickness barrier's reach, in spacings (ShellCoupling::barrier).
+constexpr double kBarrier = 0.25;
+}  // namespace
+
+Vec3 ShellCoupling::barrier_pair(const Particles& P, const Shells& shells, const Periodic& per, uint32_t a,
+                                 uint32_t q, double K) const {
+  const long sl = shells.slot(q);
+  if (sl < 0 || K <= 0.0) return Vec3::Zero();
+  const std::size_t s = static_cast<std::size_t>(sl);
+  const Vec3& n = wall_.normal[q];
+  const Vec3 d = per.any ? per.image(P.x[a] - P.x[q]) : Vec3(P.x[a] - P.x[q]);
+  const double sn = n.dot(d);
+  // The side: a's label for q's sheet (where it was at the start of the step), else where it is.
+  int side = sn >= 0.0 ? 1 : -1;
+  const Labels& L = labels_[static_cast<std::size_t>(band_of_[a])];
+  for (uint8_t k = 0; k < L.n; ++k)
+    if (L.l[k].body == P.body[q]) side = L.l[k].side;
+  const double gap = side * sn;  // <= 0: across q's plane, the guard's business
+  // The imaginary particles put the wall's surface at the mid-surface and fluid rests about dx / 2 off it
+  // (a wall's first layer); the barrier sits inside that, whatever the sheet's own thickness.
+  const double dc = kBarrier * dx_;
+  if (gap <= 0.0 || gap >= dc) return Vec3::Zero();
+  const Vec3 foot = d - sn * n;
+  const double rho = foot.norm();
+  if (rho >= 2.0 * dx_) return Vec3::Zero();
+  // Only over the sheet (its patches reach dx / 2 beyond the edge rows): beside a free edge the fluid passes
+  // round it.
+  if (!shells.over_sheet(s, foot, std::sqrt(0.5) * dx_)) return Vec3::Zero();
+  const double w = dx_ * dx_ * shells.area(s) * cubic_spline_2d(rho, dx_);  // A_a A_q W2, A_a = dx^2
+  const Vec3 e = side * n;
+  const double rate = (P.v[a] - P.v[q]).dot(e);
+  // Damper: half the critical damping of the spring K / d_c per area on the pair's reduced mass per area.
+  const double mu_a = P.m[a] / (dx_ * dx_), mu_q = shells.mass(s) / shells.area(s);
+  const double c = std::sqrt(K / dc * mu_a * mu_q / (mu_a + mu_q));
+  const double p = std::max(K * (1.0 - gap / dc) - c * rate, 0.0);
+  return (p * w) * e;
+}
+
+void ShellCoupling::barrier(Particles& P, const Shells& shells, const Periodic& per,
+                            const std::vector<double>& K, std::vector<Vec3>& force) const {
+  if (!active_) return;
+  // Gather: each band row sums its own pairs (the fluid particle over its shell partners, the shell particle
+  // over its fluid partners), each pair computed as barrier_pair(fluid, shell) from both ends, so action =
+  // reaction bit for bit and the sums do not depend on the thread count.
+  parallel_for(band_.size(), [&](std::size_t r) {
+    const uint32_t i = band_[r];
+    const Kind ki = P.kind[i];
+    if (ki != Kind::Fluid && ki != Kind::Shell) return;
+    Vec3 sum = Vec3::Zero();
+    for (uint32_t k = saved_offset_[r]; k < saved_offset_[r + 1]; ++k) {
+      const uint32_t j = saved_[k];
+      if (ki == Kind::Fluid && P.kind[j] == Kind::Shell)
+        sum += barrier_pair(P, shells, per, i, j, K[P.material[i]]);
+      else if (ki == Kind::Shell && P.kind[j] == Kind::Fluid && band_of_[j] >= 0)
+        sum -= barrier_pair(P, shells, per, j, i, K[P.material[j]]);
+    }
+    if (ki == Kind::Fluid)
+      P.a[i] += sum / P.m[i];
+    else
+      force[i] += sum;
+  });
 }
 
 std::size_t ShellCoupling::guard(Particles& P, const Periodic& per) {

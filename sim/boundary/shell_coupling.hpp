@@ -54,6 +54,15 @@ class ShellCoupling {
   void prepare(const Particles& P, const Shells& shells, NeighborSearch& nb, const Periodic& per);
   // After the drift: fluid particles that crossed a sheet are put back (see above). Returns how many.
   std::size_t guard(Particles& P, const Periodic& per);
+  // The barrier (docs/model.md, "Fluid on both sides of a shell"): a fluid particle whose centre comes
+  // within d_c = dx / 4 of a sheet's mid-surface (half its resting distance from a wall), on its own side and
+  // over the sheet, is
+  // pushed back by a contact pressure p = K (1 - s / d_c) - c ds/dt (never pulling; s the gap to the shell
+  // particle's tangent plane, weighted over the patch like the shell contact, sim/solid/shell_contact.hpp),
+  // and the shell particle takes the opposite force. K per fluid material [Pa] (0: off). Adds to P.a of the
+  // fluid particles and to `force` (indexed like P) of the shell particles. After prepare() (the labels).
+  void barrier(Particles& P, const Shells& shells, const Periodic& per, const std::vector<double>& K,
+               std::vector<Vec3>& force) const;
 
   const ShellWall& wall() const { return wall_; }
 
@@ -80,6 +89,9 @@ class ShellCoupling {
   };
 
   bool blocked(const Particles& P, const Periodic& per, uint32_t a, uint32_t b) const;
+  // The barrier's force on fluid particle a from shell particle q (zero outside the barrier).
+  Vec3 barrier_pair(const Particles& P, const Shells& shells, const Periodic& per, uint32_t a, uint32_t q,
+                    double K) const;
   bool pierces(const Particles& P, const Periodic& per, uint32_t a, uint32_t b, uint16_t body) const;
   // Whether the segment xa -> xb crosses the sheet of `body` near the shell particles of band row `row`.
   bool segment_pierces(const Particles& P, const Periodic& per, const Vec3& xa, const Vec3& xb, int32_t row,

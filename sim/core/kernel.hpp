@@ -51,4 +51,17 @@ struct CubicSpline {
   }
 };
 
+// The 2-D cubic spline (Monaghan & Lattanzio 1985), normalisation 10 / (7 pi h^2), support 2h: the patch
+// weight of a sheet's particles over its tangent plane (shell contact, the fluid's thickness barrier).
+inline double cubic_spline_2d(double r, double h) {
+  const double q = r / h;
+  const double alpha = 10.0 / (7.0 * std::numbers::pi * h * h);
+  if (q < 1.0) return alpha * (1.0 - 1.5 * q * q + 0.75 * q * q * q);
+  if (q < 2.0) {
+    const double t = 2.0 - q;
+    return alpha * 0.25 * t * t * t;
+  }
+  return 0.0;
+}
+
 }  // namespace aortasph

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 
+#include "core/kernel.hpp"
 #include "core/parallel.hpp"
 
 namespace aortasph {
@@ -12,18 +12,6 @@ namespace aortasph {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// 2-D cubic spline (Monaghan & Lattanzio 1985), normalisation 10 / (7 pi h^2), support 2h.
-double W2(double r, double h) {
-  const double q = r / h;
-  const double alpha = 10.0 / (7.0 * std::numbers::pi * h * h);
-  if (q < 1.0) return alpha * (1.0 - 1.5 * q * q + 0.75 * q * q * q);
-  if (q < 2.0) {
-    const double t = 2.0 - q;
-    return alpha * 0.25 * t * t * t;
-  }
-  return 0.0;
-}
 
 bool volumetric(Kind k) {
   return k == Kind::Wall || k == Kind::Elastic;
@@ -98,7 +86,7 @@ ShellContact::Pair ShellContact::pair(const Particles& P, const Shells& sh, std:
     // stiffness without bound and a step of 1e-8 s.
     if (!(a_shell && b_shell) && !sh.over_sheet(slot(s), d - sn * n, std::sqrt(0.5) * dx))
       return Vec3::Zero();
-    const double w = weight * area_a * area_b * W2(rho, dx);
+    const double w = weight * area_a * area_b * cubic_spline_2d(rho, dx);
     const Vec3 e = sn >= 0.0 ? n : Vec3(-n);  // from q's plane towards o
     const double rate = v.dot(e);             // d(gap)/dt
     out.near = true;
