@@ -233,7 +233,7 @@ struct Contact {
   double shell_damping = 0.5;
   // Fluid against a sheet's thickness (ShellCoupling::barrier): the barrier's modulus in units of the fluid's
   // rho0 c0^2 (0: off).
-  double shell_fluid_barrier = 1.0;
+  double shell_fluid_barrier = 0.0;
 };
 
 enum class ProbeType {
