@@ -272,6 +272,10 @@ World::World(const Scene& scene)
     if (have_fluid) {  // fluid on either side of a sheet (sim/boundary/shell_coupling.hpp)
       coupling_ = ShellCoupling(P_, shells_, dx, kernel_.support, wall_ref_.rho0);
       ctx_.shell_wall = &coupling_.wall();
+      // The fluid's barrier modulus per material (ShellCoupling::barrier): the scene's factor of rho0 c0^2.
+      if (scene_.contact.shell_fluid_barrier > 0.0)
+        for (const FluidParams& f : fluid_)
+          barrier_modulus_.push_back(scene_.contact.shell_fluid_barrier * f.rho0 * f.c0 * f.c0);
     }
   }
   if (!solids_.empty() && contact_.k > 0.0)
@@ -523,12 +527,8 @@ void World::body_forces() {
   shell_contact_.add_forces(P_, nb_, shells_, ctx_.periodic, force_);  // sim/solid/shell_contact.hpp
   // Fluid against a sheet's thickness: the fluid particle's share goes into its acceleration (after
   // fluid_forces), the sheet's into force_.
-  if (coupling_.active() && scene_.contact.shell_fluid_barrier > 0.0) {
-    std::vector<double> K(fluid_.size(), 0.0);
-    for (std::size_t m = 0; m < fluid_.size(); ++m)
-      K[m] = scene_.contact.shell_fluid_barrier * fluid_[m].rho0 * fluid_[m].c0 * fluid_[m].c0;
-    coupling_.barrier(P_, shells_, ctx_.periodic, K, force_);
-  }
+  if (coupling_.active() && !barrier_modulus_.empty())
+    coupling_.barrier(P_, shells_, ctx_.periodic, barrier_modulus_, force_);
 }
 
 // Elastic particles: internal forces (eqs. 14-18 with their stabilisers) plus what body_forces() found (the

@@ -215,8 +215,9 @@ class World {
   std::vector<RigidBody> rigid_;
   Solids solids_;
   Shells shells_;
-  ShellSheets sheets_;      // the shells' triangulated mid-surfaces (render, VTK)
-  ShellCoupling coupling_;  // active when a scene has shells and a fluid
+  ShellSheets sheets_;                   // the shells' triangulated mid-surfaces (render, VTK)
+  ShellCoupling coupling_;               // active when a scene has shells and a fluid
+  std::vector<double> barrier_modulus_;  // per material, the fluid's barrier K [Pa]; empty: off
   // Shell sub-cycling state (step_shells): leapfrog velocities by shell slot (empty until the first step,
   // then filled from P.v), the last sub-step's length, the largest speed and acceleration of the last step's
   // sub-steps, and counters.

@@ -56,11 +56,11 @@ class ShellCoupling {
   std::size_t guard(Particles& P, const Periodic& per);
   // The barrier (docs/model.md, "Fluid on both sides of a shell"): a fluid particle whose centre comes
   // within d_c = dx / 4 of a sheet's mid-surface (half its resting distance from a wall), on its own side and
-  // over the sheet, is
-  // pushed back by a contact pressure p = K (1 - s / d_c) - c ds/dt (never pulling; s the gap to the shell
-  // particle's tangent plane, weighted over the patch like the shell contact, sim/solid/shell_contact.hpp),
-  // and the shell particle takes the opposite force. K per fluid material [Pa] (0: off). Adds to P.a of the
-  // fluid particles and to `force` (indexed like P) of the shell particles. After prepare() (the labels).
+  // over the sheet, is pushed back by a contact pressure p = K (1 - s / d_c) - c ds/dt (never pulling; s the
+  // gap to the shell particle's tangent plane, weighted over the patch like the shell contact,
+  // sim/solid/shell_contact.hpp), and the shell particle takes the opposite force. K per fluid material [Pa]
+  // (0: off). Adds to P.a of the fluid particles and to `force` (indexed like P) of the shell particles.
+  // After prepare() (the labels).
   void barrier(Particles& P, const Shells& shells, const Periodic& per, const std::vector<double>& K,
                std::vector<Vec3>& force) const;
 
