@@ -525,10 +525,7 @@ void World::body_forces() {
   fluid_reaction(P_, nb_, ctx_, force_);
   contact_forces(P_, nb_, contact_, force_, moment_);
   shell_contact_.add_forces(P_, nb_, shells_, ctx_.periodic, force_);  // sim/solid/shell_contact.hpp
-  // Fluid against a sheet's thickness: the fluid particle's share goes into its acceleration (after
-  // fluid_forces), the sheet's into force_.
-  if (coupling_.active() && !barrier_modulus_.empty())
-    coupling_.barrier(P_, shells_, ctx_.periodic, barrier_modulus_, force_);
+  // (The fluid's barrier against a sheet acts in the shells' sub-steps: step_shells.)
 }
 
 // Elastic particles: internal forces (eqs. 14-18 with their stabilisers) plus what body_forces() found (the
@@ -589,12 +586,13 @@ void World::add_shell_seeds(const Body& body, const std::string& where, const Sh
 // Shells, sub-cycled within the step (issue 16; the multi-time-step coupling of Zhang, Rezavand & Hu 2021,
 // J. Comput. Phys. 429, 110028, as SPHinXsys runs it): the step dt is the fluid's (and other bodies'), and
 // the shells take n = ceil(dt / dt_shell) equal sub-steps h = dt / n inside it, with what body_forces() found
-// (the fluid's reaction, contact) held over them. Each sub-step is the leapfrog of integrate() on the shells'
-// own velocities (sub_.v, half a sub-step behind the positions): the first kick spans the last sub-step of
-// the previous step and this one, (h_prev + h) / 2, the others h. What the fluid sees of a shell particle is
-// its end position, its mean velocity over the step (the mean of the sub-steps' velocities, (x(t + dt) -
-// x(t)) / dt: the half-step velocity of the fluid's own leapfrog) in P.v, and its mean acceleration in P.a.
-// With n = 1 this is the plain leapfrog of integrate(), bit for bit.
+// (the fluid's reaction, contact) held over them; the fluid's barrier, stiff against a light sheet, is
+// evaluated in each sub-step and the fluid takes its mean (ShellCoupling::barrier_begin). Each sub-step is
+// the leapfrog of integrate() on the shells' own velocities (sub_.v, half a sub-step behind the positions):
+// the first kick spans the last sub-step of the previous step and this one, (h_prev + h) / 2, the others h.
+// What the fluid sees of a shell particle is its end position, its mean velocity over the step (the mean of
+// the sub-steps' velocities, (x(t + dt) - x(t)) / dt: the half-step velocity of the fluid's own leapfrog) in
+// P.v, and its mean acceleration in P.a. With n = 1 this is the plain leapfrog of integrate(), bit for bit.
 void World::step_shells(double dt) {
   const std::size_t ns = shells_.size();
   if (sub_.v.size() != ns) {  // the first step (or a checkpoint without this state): from P.v
@@ -609,12 +607,19 @@ void World::step_shells(double dt) {
   }
   const int n = std::max(1, static_cast<int>(std::ceil(dt / shell_stable_dt() * (1.0 - 1e-12))));
   const double h = dt / n;
-  std::vector<Vec3> held(ns), vsum(ns, Vec3::Zero()), asum(ns, Vec3::Zero());
+  std::vector<Vec3> held(ns), vsum(ns, Vec3::Zero()), asum(ns, Vec3::Zero()), barrier;
   std::vector<double> v2(ns, 0.0), a2(ns, 0.0);
   parallel_for(ns, [&](std::size_t s) { held[s] = force_[shells_.at(s)]; });
+  // The fluid's barrier (ShellCoupling::barrier_begin) in every sub-step: the pairs that can come within its
+  // reach while the sheets move by up to a quarter spacing plus twice their fastest speed over the step.
+  const bool bar = coupling_.active() && !barrier_modulus_.empty();
+  if (bar)
+    coupling_.barrier_begin(P_, shells_, ctx_.periodic, barrier_modulus_,
+                            0.25 * scene_.spacing + 2.0 * sub_.max_speed * dt);
   for (int k = 0; k < n; ++k) {
     const double kick = k == 0 && sub_.last_h > 0.0 ? 0.5 * (sub_.last_h + h) : h;
-    shell_substep(h, kick, time_ + k * h, held);
+    if (bar) coupling_.barrier_substep(P_, shells_, ctx_.periodic, barrier_modulus_, sub_.v, h, barrier);
+    shell_substep(h, kick, time_ + k * h, held, bar ? &barrier : nullptr);
     parallel_for(ns, [&](std::size_t s) {
       const uint32_t i = shells_.at(s);
       vsum[s] += sub_.v[s];
@@ -628,6 +633,7 @@ void World::step_shells(double dt) {
     P_.v[i] = vsum[s] / static_cast<double>(n);
     P_.a[i] = asum[s] / static_cast<double>(n);
   });
+  if (bar) coupling_.barrier_end(P_, dt);  // the fluid's share: its mean over the sub-steps
   const auto max = [](double a, double b) { return std::max(a, b); };
   sub_.max_speed = std::sqrt(parallel_reduce(
       ns, 0.0, [&](std::size_t s) { return v2[s]; }, max));
@@ -640,10 +646,12 @@ void World::step_shells(double dt) {
 }
 
 // One shell sub-step of length h at time t: resultants, internal forces and director moments
-// (Shells::update), plus the held forces, gravity, the body's pressure load p(t) A n along the current normal
+// (Shells::update), plus the held forces, the fluid's barrier at the sheet's current position (`barrier`, by
+// slot, or null), gravity, the body's pressure load p(t) A n along the current normal
 // and the material's damping; then velocity, position and director (their leapfrog). Supported particles hold
 // their position (and, fixed, their director).
-void World::shell_substep(double h, double kick, double t, const std::vector<Vec3>& held) {
+void World::shell_substep(double h, double kick, double t, const std::vector<Vec3>& held,
+                          const std::vector<Vec3>* barrier) {
   shells_.update(P_);
   std::vector<double> pressure(bodies_.size(), 0.0);
   for (std::size_t b = 0; b < bodies_.size(); ++b)
@@ -657,8 +665,8 @@ void World::shell_substep(double h, double kick, double t, const std::vector<Vec
       v = Vec3::Zero();
       return;
     }
-    const Vec3 f =
-        held[s] + shells_.internal_force(s) + pressure[P_.body[i]] * shells_.area(s) * shells_.normal(s);
+    Vec3 f = held[s] + shells_.internal_force(s) + pressure[P_.body[i]] * shells_.area(s) * shells_.normal(s);
+    if (barrier) f += (*barrier)[s];
     P_.a[i] = f / shells_.mass(s) + gravity_ - shells_.damping(s) * v;
     if (shells_.support(s) == 3) {  // a diaphragm (validations): held in the plane across free_axis
       const Vec3& ax = shells_.free_axis(s);

@@ -197,7 +197,8 @@ class World {
   void step_rigid(double dt);
   void step_solids();
   void step_shells(double dt);
-  void shell_substep(double h, double kick, double t, const std::vector<Vec3>& held);
+  void shell_substep(double h, double kick, double t, const std::vector<Vec3>& held,
+                     const std::vector<Vec3>* barrier);
   void add_shell_seeds(const Body& body, const std::string& where, const ShapeSample& sample,
                        std::size_t first, std::vector<ShellSeed>& seeds) const;
   void permute(const std::vector<uint32_t>& order);

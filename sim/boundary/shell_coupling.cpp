@@ -262,11 +262,11 @@ constexpr double kBarrier = 0.25;
 }  // namespace
 
 Vec3 ShellCoupling::barrier_pair(const Particles& P, const Shells& shells, const Periodic& per, uint32_t a,
-                                 uint32_t q, double K) const {
+                                 uint32_t q, const Vec3& vq, double K) const {
   const long sl = shells.slot(q);
   if (sl < 0 || K <= 0.0) return Vec3::Zero();
   const std::size_t s = static_cast<std::size_t>(sl);
-  const Vec3& n = wall_.normal[q];
+  const Vec3& n = shells.director(s);  // the sheet's normal now (in a sub-step: as it has turned)
   const Vec3 d = per.any ? per.image(P.x[a] - P.x[q]) : Vec3(P.x[a] - P.x[q]);
   const double sn = n.dot(d);
   // The side: a's label for q's sheet (where it was at the start of the step), else where it is.
@@ -287,7 +287,7 @@ Vec3 ShellCoupling::barrier_pair(const Particles& P, const Shells& shells, const
   if (!shells.over_sheet(s, foot, std::sqrt(0.5) * dx_)) return Vec3::Zero();
   const double w = dx_ * dx_ * shells.area(s) * cubic_spline_2d(rho, dx_);  // A_a A_q W2, A_a = dx^2
   const Vec3 e = side * n;
-  const double rate = (P.v[a] - P.v[q]).dot(e);
+  const double rate = (P.v[a] - vq).dot(e);
   // Damper: half the critical damping of the spring K / d_c per area on the pair's reduced mass per area.
   const double mu_a = P.m[a] / (dx_ * dx_), mu_q = shells.mass(s) / shells.area(s);
   const double c = std::sqrt(K / dc * mu_a * mu_q / (mu_a + mu_q));
@@ -295,29 +295,92 @@ Vec3 ShellCoupling::barrier_pair(const Particles& P, const Shells& shells, const
   return (p * w) * e;
 }
 
-void ShellCoupling::barrier(Particles& P, const Shells& shells, const Periodic& per,
-                            const std::vector<double>& K, std::vector<Vec3>& force) const {
+void ShellCoupling::barrier_begin(const Particles& P, const Shells& shells, const Periodic& per,
+                                  const std::vector<double>& K, double margin) {
+  bar_rows_.clear();
+  bar_offset_.clear();
+  bar_.clear();
+  bar_impulse_.clear();
   if (!active_) return;
-  // Gather: each band row sums its own pairs (the fluid particle over its shell partners, the shell particle
-  // over its fluid partners), each pair computed as barrier_pair(fluid, shell) from both ends, so action =
-  // reaction bit for bit and the sums do not depend on the thread count.
-  parallel_for(band_.size(), [&](std::size_t r) {
+  // A pair is a candidate when, with the sheet as it is at the start of the step, the fluid particle lies
+  // within the barrier's reach widened by the margin (the same test from both ends, so the lists agree).
+  const double dc = kBarrier * dx_;
+  const auto candidate = [&](uint32_t a, uint32_t q) {
+    if (K[P.material[a]] <= 0.0 || band_of_[a] < 0) return false;
+    const long sl = shells.slot(q);
+    if (sl < 0) return false;
+    const Vec3& n = shells.director(static_cast<std::size_t>(sl));
+    const Vec3 d = per.any ? per.image(P.x[a] - P.x[q]) : Vec3(P.x[a] - P.x[q]);
+    const double sn = n.dot(d);
+    if (std::abs(sn) >= dc + margin) return false;
+    return (d - sn * n).squaredNorm() < (2.0 * dx_ + margin) * (2.0 * dx_ + margin);
+  };
+  const auto partner = [&](uint32_t i, uint32_t j) {
+    const Kind ki = P.kind[i], kj = P.kind[j];
+    if (ki == Kind::Fluid && kj == Kind::Shell) return candidate(i, j);
+    if (ki == Kind::Shell && kj == Kind::Fluid) return candidate(j, i);
+    return false;
+  };
+  const std::size_t nb = band_.size();
+  std::vector<uint32_t> count(nb, 0);
+  parallel_for(nb, [&](std::size_t r) {
     const uint32_t i = band_[r];
-    const Kind ki = P.kind[i];
-    if (ki != Kind::Fluid && ki != Kind::Shell) return;
-    Vec3 sum = Vec3::Zero();
-    for (uint32_t k = saved_offset_[r]; k < saved_offset_[r + 1]; ++k) {
-      const uint32_t j = saved_[k];
-      if (ki == Kind::Fluid && P.kind[j] == Kind::Shell)
-        sum += barrier_pair(P, shells, per, i, j, K[P.material[i]]);
-      else if (ki == Kind::Shell && P.kind[j] == Kind::Fluid && band_of_[j] >= 0)
-        sum -= barrier_pair(P, shells, per, j, i, K[P.material[j]]);
-    }
-    if (ki == Kind::Fluid)
-      P.a[i] += sum / P.m[i];
-    else
-      force[i] += sum;
+    if (P.kind[i] != Kind::Fluid && P.kind[i] != Kind::Shell) return;
+    uint32_t c = 0;
+    for (uint32_t k = saved_offset_[r]; k < saved_offset_[r + 1]; ++k) c += partner(i, saved_[k]) ? 1 : 0;
+    count[r] = c;
   });
+  bar_offset_.push_back(0);
+  for (std::size_t r = 0; r < nb; ++r)
+    if (count[r] > 0) {
+      bar_rows_.push_back(static_cast<uint32_t>(r));
+      bar_offset_.push_back(bar_offset_.back() + count[r]);
+    }
+  bar_.resize(bar_offset_.back());
+  bar_impulse_.assign(bar_rows_.size(), Vec3::Zero());
+  parallel_for(bar_rows_.size(), [&](std::size_t k) {
+    const std::size_t r = bar_rows_[k];
+    const uint32_t i = band_[r];
+    uint32_t out = bar_offset_[k];
+    for (uint32_t m = saved_offset_[r]; m < saved_offset_[r + 1]; ++m)
+      if (partner(i, saved_[m])) bar_[out++] = saved_[m];
+  });
+}
+
+void ShellCoupling::barrier_substep(const Particles& P, const Shells& shells, const Periodic& per,
+                                    const std::vector<double>& K, const std::vector<Vec3>& shell_v, double h,
+                                    std::vector<Vec3>& shell_force) {
+  shell_force.assign(shells.size(), Vec3::Zero());
+  // Gather: each row sums its own pairs (the fluid particle over its shell partners, the shell particle over
+  // its fluid partners), each pair computed as barrier_pair(fluid, shell) from both ends, so action =
+  // reaction bit for bit and the sums do not depend on the thread count.
+  parallel_for(bar_rows_.size(), [&](std::size_t k) {
+    const uint32_t i = band_[bar_rows_[k]];
+    Vec3 sum = Vec3::Zero();
+    if (P.kind[i] == Kind::Fluid) {
+      for (uint32_t m = bar_offset_[k]; m < bar_offset_[k + 1]; ++m) {
+        const uint32_t q = bar_[m];
+        sum += barrier_pair(P, shells, per, i, q, shell_v[static_cast<std::size_t>(shells.slot(q))],
+                            K[P.material[i]]);
+      }
+      bar_impulse_[k] += h * sum;
+    } else {
+      const std::size_t s = static_cast<std::size_t>(shells.slot(i));
+      for (uint32_t m = bar_offset_[k]; m < bar_offset_[k + 1]; ++m) {
+        const uint32_t a = bar_[m];
+        sum -= barrier_pair(P, shells, per, a, i, shell_v[s], K[P.material[a]]);
+      }
+      shell_force[s] = sum;
+    }
+  });
+}
+
+void ShellCoupling::barrier_end(Particles& P, double dt) {
+  parallel_for(bar_rows_.size(), [&](std::size_t k) {
+    const uint32_t i = band_[bar_rows_[k]];
+    if (P.kind[i] == Kind::Fluid) P.a[i] += bar_impulse_[k] / (dt * P.m[i]);
+  });
+  bar_rows_.clear();
 }
 
 std::size_t ShellCoupling::guard(Particles& P, const Periodic& per) {

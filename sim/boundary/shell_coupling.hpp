@@ -59,10 +59,20 @@ class ShellCoupling {
   // over the sheet, is pushed back by a contact pressure p = K (1 - s / d_c) - c ds/dt (never pulling; s the
   // gap to the shell particle's tangent plane, weighted over the patch like the shell contact,
   // sim/solid/shell_contact.hpp), and the shell particle takes the opposite force. K per fluid material [Pa]
-  // (0: off). Adds to P.a of the fluid particles and to `force` (indexed like P) of the shell particles.
-  // After prepare() (the labels).
-  void barrier(Particles& P, const Shells& shells, const Periodic& per, const std::vector<double>& K,
-               std::vector<Vec3>& force) const;
+  // (0: off). It is stiff for a light sheet (a 0.45 mm leaflet has half the mass per area of one fluid
+  // particle), so it is evaluated in the shells' sub-steps (World::step_shells), not held over the fluid's
+  // step: barrier_begin() once per step after prepare() (the labels) picks the pairs that can come within
+  // reach during the step (the shells move by at most `margin`), barrier_substep() gives the shell particles'
+  // forces at their current positions, directors and velocities (by slot) and adds h times the opposite
+  // force to the fluid particles' impulses, and barrier_end() adds the fluid's mean force over the step,
+  // impulse / (dt m), to P.a: the impulses are equal and opposite, bit for bit.
+  void barrier_begin(const Particles& P, const Shells& shells, const Periodic& per,
+                     const std::vector<double>& K, double margin);
+  void barrier_substep(const Particles& P, const Shells& shells, const Periodic& per,
+                       const std::vector<double>& K, const std::vector<Vec3>& shell_v, double h,
+                       std::vector<Vec3>& shell_force);
+  void barrier_end(Particles& P, double dt);
+  bool barrier_pending() const { return !bar_rows_.empty(); }
 
   const ShellWall& wall() const { return wall_; }
 
@@ -89,9 +99,9 @@ class ShellCoupling {
   };
 
   bool blocked(const Particles& P, const Periodic& per, uint32_t a, uint32_t b) const;
-  // The barrier's force on fluid particle a from shell particle q (zero outside the barrier).
+  // The barrier's force on fluid particle a from shell particle q moving at vq (zero outside the barrier).
   Vec3 barrier_pair(const Particles& P, const Shells& shells, const Periodic& per, uint32_t a, uint32_t q,
-                    double K) const;
+                    const Vec3& vq, double K) const;
   bool pierces(const Particles& P, const Periodic& per, uint32_t a, uint32_t b, uint16_t body) const;
   // Whether the segment xa -> xb crosses the sheet of `body` near the shell particles of band row `row`.
   bool segment_pierces(const Particles& P, const Periodic& per, const Vec3& xa, const Vec3& xb, int32_t row,
@@ -113,6 +123,10 @@ class ShellCoupling {
   std::vector<uint32_t> saved_offset_, saved_;
   std::vector<Labels> labels_;
   std::vector<Vec3> x_before_;  // band rows' positions at prepare() (the guard's path near free edges)
+  // The barrier's candidate pairs this step (barrier_begin): band rows that have any (index into band_),
+  // their partners (CSR), and the fluid rows' impulses summed over the sub-steps.
+  std::vector<uint32_t> bar_rows_, bar_offset_, bar_;
+  std::vector<Vec3> bar_impulse_;
   long crossings_ = 0;
   std::size_t masked_ = 0;
 };
