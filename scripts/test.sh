@@ -48,9 +48,11 @@ if [ "${AORTASPH_SKIP_SANITIZE:-0}" != 1 ]; then
   fi
   for k in 0 1; do
     # Catch2 reads one test name per line; its spec syntax needs , [ ] * \ " escaped.
+    # --durations: each case's time goes into the shard's log (build-san/asan-shard0.log, ...), to find what to
+    # keep out of the shards when the step grows.
     awk -v k=$k 'NR % 2 == k' build-san/asan-cases.txt | sed 's/[][,\\*"]/\\&/g' > build-san/asan-shard$k.txt
     OMP_NUM_THREADS=1 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-      ./build-san/tests/aortasph_tests -f build-san/asan-shard$k.txt > build-san/asan-shard$k.log 2>&1 &
+      ./build-san/tests/aortasph_tests --durations yes -f build-san/asan-shard$k.txt > build-san/asan-shard$k.log 2>&1 &
     pids+=($!)
   done
   listed=$(cat build-san/asan-shard0.txt build-san/asan-shard1.txt |
