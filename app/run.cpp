@@ -103,8 +103,10 @@ class Progress {
 };
 
 std::vector<std::string> diagnostics_columns() {
-  std::vector<std::string> cols = {"steps",    "dt",        "particles",        "fluid",
-                                   "boundary", "max_speed", "max_density_error"};
+  // shell_crossings: the guard's put-backs since t = 0 (fluid particles stopped at a sheet; 0 without
+  // shells).
+  std::vector<std::string> cols = {"steps",    "dt",        "particles",         "fluid",
+                                   "boundary", "max_speed", "max_density_error", "shell_crossings"};
   for (const auto& [name, sec] : Profile{}.phases()) cols.push_back("wall_" + name);
   cols.push_back("wall_total");
   return cols;
@@ -113,8 +115,15 @@ std::vector<std::string> diagnostics_columns() {
 std::vector<double> diagnostics_row(const World& w) {
   const double n = static_cast<double>(w.particles().size());
   const double fluid = static_cast<double>(w.count(Kind::Fluid));
-  std::vector<double> row = {w.time(),      static_cast<double>(w.steps()), w.last_dt(), n, fluid, n - fluid,
-                             w.max_speed(), w.max_density_error()};
+  std::vector<double> row = {w.time(),
+                             static_cast<double>(w.steps()),
+                             w.last_dt(),
+                             n,
+                             fluid,
+                             n - fluid,
+                             w.max_speed(),
+                             w.max_density_error(),
+                             static_cast<double>(w.shell_crossings())};
   for (const auto& [name, sec] : w.profile().phases()) row.push_back(sec);
   row.push_back(w.profile().total());
   return row;

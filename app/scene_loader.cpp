@@ -241,7 +241,7 @@ class Loader {
     s.contact.shell_stiffness = con.non_negative("shell_stiffness", 0.0);
     if (con.has("shell_margin")) s.contact.shell_margin = con.non_negative("shell_margin", 0.0);
     s.contact.shell_damping = con.non_negative("shell_damping", 0.5);
-    s.contact.shell_fluid_barrier = con.non_negative("shell_fluid_barrier", 0.0);
+    s.contact.shell_fluid_barrier = con.non_negative("shell_fluid_barrier", 1.0);
 
     // Geometry shared by the aortic_root shapes (each shape's own keys override it).
     if (top.has("aortic_root")) {

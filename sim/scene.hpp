@@ -231,9 +231,9 @@ struct Contact {
   double shell_stiffness = 0.0;
   double shell_margin = -1.0;
   double shell_damping = 0.5;
-  // Fluid against a sheet's thickness (ShellCoupling::barrier): the barrier's modulus in units of the fluid's
-  // rho0 c0^2 (0: off).
-  double shell_fluid_barrier = 0.0;
+  // Fluid against a sheet's thickness (ShellCoupling::barrier_begin): the barrier's modulus in units of the
+  // fluid's rho0 c0^2 (0: off; on by default since stop 34).
+  double shell_fluid_barrier = 1.0;
 };
 
 enum class ProbeType {
