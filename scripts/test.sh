@@ -6,8 +6,9 @@
 # thread comparison, then the commissure posts 40 s, the fluid-and-block checkpoint 25 s, the mirror-leaflet
 # geometry 15 s and two shell-contact rests 14 and 13 s, measured on the quiet machine; at stop 27 the shell
 # leaflets' half-spacing case 49 s, the rotated-commissure geometry 32 s and `aortasph check` of the aortic
-# scenes 33 s, on a loaded machine), each while other cases cover its code under the sanitizers; they all run in
-# the Release step), a ThreadSanitizer build runs the simulation-render pipeline test, a bounded libFuzzer run
+# scenes 33 s, on a loaded machine; at stop 34 six 1-vs-2-thread comparisons, 48 s of shard time, which
+# ThreadSanitizer and the Release step check, and the light-sheet barrier case, 16 s), each while other cases
+# cover its code under the sanitizers; they all run in the Release step), a ThreadSanitizer build runs the simulation-render pipeline test, a bounded libFuzzer run
 # fuzzes the scene loader (scripts/fuzz.sh, built in the same clang sanitizer tree), then the Release build (GCC)
 # runs every test through CTest. The validation-size
 # cases (tag [.validation], hidden from CTest: rigid blocks sinking and floating, the TL-SPH cantilever's energy

@@ -122,7 +122,7 @@ TEST_CASE("tensile correction: fewer particles pair up in the expanding sheet, m
   CHECK(dp < 1e-10);
 }
 
-TEST_CASE("a fluid run is bitwise identical for 1 and 2 threads", "[fluid][determinism]") {
+TEST_CASE("a fluid run is bitwise identical for 1 and 2 threads", "[fluid][determinism][heavy]") {
   const Scene s = dam_break(0.05715, 0.05715 / 8, 3 * 0.05715 / 8);
   uint64_t hashes[2];
   for (int t = 1; t <= 2; ++t) {

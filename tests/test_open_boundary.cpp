@@ -320,7 +320,7 @@ TEST_CASE("tube flow: a parabolic inflow stays roughly parabolic mid-tube", "[op
   CHECK(edge < 0.8 * 0.05);
 }
 
-TEST_CASE("tube flow: identical probes and state for 1 and 2 threads", "[open][determinism]") {
+TEST_CASE("tube flow: identical probes and state for 1 and 2 threads", "[open][determinism][heavy]") {
   TubeSetup t;
   t.parabolic = true;  // columns cross at different steps: creations and removals every few steps
   t.initial_velocity = 0.1;

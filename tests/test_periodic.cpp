@@ -115,7 +115,7 @@ TEST_CASE("plane Poiseuille flow between no-slip plates matches the parabola wit
   CHECK(error[0] / error[1] > 1.7);  // converging at about first order or better
 }
 
-TEST_CASE("a periodic run is bitwise identical for 1 and 2 threads", "[periodic][determinism]") {
+TEST_CASE("a periodic run is bitwise identical for 1 and 2 threads", "[periodic][determinism][heavy]") {
   const Poiseuille c;
   uint64_t hash[2] = {0, 0};
   for (int t = 1; t <= 2; ++t) {

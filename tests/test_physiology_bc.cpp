@@ -502,7 +502,7 @@ TEST_CASE("windkessel outlet and pressure inlet: a checkpoint continues bitwise"
 }
 
 TEST_CASE("windkessel outlet and pressure inlet: identical probes and state for 1 and 2 threads",
-          "[physiology][determinism]") {
+          "[physiology][determinism][heavy]") {
   const Scene s = cycle_tube();
   std::vector<double> values[2];
   uint64_t hash[2];

@@ -401,7 +401,7 @@ TEST_CASE("shell: a strip periodic across its width bends cylindrically, as the 
   CHECK(hi - lo < 1e-6 * w_ref);  // uniform across the width: no edge, the sheet closes on itself
 }
 
-TEST_CASE("shell: 1 and 2 threads give bitwise the same run", "[shell]") {
+TEST_CASE("shell: 1 and 2 threads give bitwise the same run", "[shell][heavy]") {
   const int before = max_threads();
   uint64_t hash[2] = {0, 0};
   Vec3 d[2];

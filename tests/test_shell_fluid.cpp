@@ -259,7 +259,7 @@ TEST_CASE("shell-fluid: a plate between two water columns deflects by the net lo
 }
 
 TEST_CASE("shell-fluid: 1 and 2 threads give bitwise the same run, and a checkpoint resumes bitwise",
-          "[shell_fluid][checkpoint]") {
+          "[shell_fluid][checkpoint][heavy]") {
   // An elastic sheet (edge rows clamped) between a column and a closed chamber: masks, labels, imaginary
   // particles and the guard all at work.
   const Scene s = sheet_in_shaft(0.3, 0.3, 1.02, 0.05, shell_sheet(5e6, 0.3, 0.05, 1000.0, 20.0), 40.0);
@@ -462,7 +462,7 @@ TEST_CASE("shell-fluid: the barrier keeps water skimming a free edge's plane on 
 }
 
 TEST_CASE("shell-fluid: the barrier against a sheet 40 times lighter than the fluid stays stable",
-          "[shell_fluid]") {
+          "[shell_fluid][heavy]") {
   // The barrier's spring on a light sheet particle is stiff: here (K = rho0 c0^2, mass per area rho0 dx / 40)
   // it throws the sheet's particles out of its reach within a fraction of the fluid's step. Held over the
   // whole step (as at stop 33) it goes on pushing them after they have left and puts energy in:
