@@ -378,7 +378,12 @@ int make_wiggers_plot(const fs::path& dir, std::string& error) {
     // The render block is not needed here (and a run with --end-time may hold figure times past its end).
     nlohmann::json recorded = j["scene"];
     recorded.erase("render");
-    scene = load_scene_json(recorded, {}).scene;
+    // Files the scene names (a waveform CSV) are relative to the scene file, as when it ran (and as `resume`
+    // reads them).
+    const fs::path base = j.contains("scene_file") && j["scene_file"].is_string()
+                              ? fs::path(j["scene_file"].get<std::string>()).parent_path()
+                              : fs::path();
+    scene = load_scene_json(recorded, {}, base).scene;
   } catch (const InputError& e) {
     error = run_json.string() + ": its scene: " + e.what();
     return 2;
