@@ -300,7 +300,6 @@ void ShellCoupling::barrier_begin(const Particles& P, const Shells& shells, cons
   bar_rows_.clear();
   bar_offset_.clear();
   bar_.clear();
-  bar_impulse_.clear();
   if (!active_) return;
   // A pair is a candidate when, with the sheet as it is at the start of the step, the fluid particle lies
   // within the barrier's reach widened by the margin (the same test from both ends, so the lists agree).
@@ -375,12 +374,11 @@ void ShellCoupling::barrier_substep(const Particles& P, const Shells& shells, co
   });
 }
 
-void ShellCoupling::barrier_end(Particles& P, double dt) {
+void ShellCoupling::barrier_end(Particles& P, double dt) const {
   parallel_for(bar_rows_.size(), [&](std::size_t k) {
     const uint32_t i = band_[bar_rows_[k]];
     if (P.kind[i] == Kind::Fluid) P.a[i] += bar_impulse_[k] / (dt * P.m[i]);
   });
-  bar_rows_.clear();
 }
 
 std::size_t ShellCoupling::guard(Particles& P, const Periodic& per) {

@@ -71,8 +71,7 @@ class ShellCoupling {
   void barrier_substep(const Particles& P, const Shells& shells, const Periodic& per,
                        const std::vector<double>& K, const std::vector<Vec3>& shell_v, double h,
                        std::vector<Vec3>& shell_force);
-  void barrier_end(Particles& P, double dt);
-  bool barrier_pending() const { return !bar_rows_.empty(); }
+  void barrier_end(Particles& P, double dt) const;
 
   const ShellWall& wall() const { return wall_; }
 
