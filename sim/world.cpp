@@ -668,7 +668,7 @@ void World::shell_substep(double h, double kick, double t, const std::vector<Vec
     Vec3 f = held[s] + shells_.internal_force(s) + pressure[P_.body[i]] * shells_.area(s) * shells_.normal(s);
     if (barrier) f += (*barrier)[s];
     P_.a[i] = f / shells_.mass(s) + gravity_ - shells_.damping(s) * v;
-    if (shells_.support(s) == 3) {  // a diaphragm (validations): held in the plane across free_axis
+    if (shells_.support(s) >= 3) {  // a diaphragm (validations): held in the plane across free_axis
       const Vec3& ax = shells_.free_axis(s);
       P_.a[i] = P_.a[i].dot(ax) * ax;
       v = v.dot(ax) * ax;

@@ -39,6 +39,21 @@ double von_mises_plane(const Mat3& S) {
   return std::sqrt(a * a - a * b + b * b + 3.0 * (c * c + S(0, 2) * S(0, 2) + S(1, 2) * S(1, 2)));
 }
 
+// Q(B)_dl = sum_abc B_dc B_ab m3[abcl]: the tangential part of the third-order Taylor term that the linear
+// gradient weights leave in G (see Shells::update).
+Shells::Mat2 curvature_moment(const Shells::Mat2& B, const std::array<double, 16>& m3) {
+  Shells::Mat2 Q = Shells::Mat2::Zero();
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c)
+        for (int l = 0; l < 2; ++l) {
+          const double m = B(a, b) * m3[8 * a + 4 * b + 2 * c + l];
+          Q(0, l) += B(0, c) * m;
+          Q(1, l) += B(1, c) * m;
+        }
+  return Q;
+}
+
 }  // namespace
 
 Shells::Shells(const Particles& P, const std::vector<Material>& materials, const CubicSpline& kernel,
@@ -139,10 +154,20 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
     const Mat2 L = std::abs(M.determinant()) > 1e-12 * M.squaredNorm() ? Mat2(M.inverse()) : Mat2::Zero();
     for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) g_[k] = L * hv[k - offset_[s]];
   });
+  m3_.assign(n, {});
+  parallel_for(n, [&](std::size_t s) {
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const Vec3 X = sep(X_[nbr_[k]], X_[s]);
+      const double a[2] = {T1_[s].dot(X), T2_[s].dot(X)};
+      for (int i = 0; i < 16; ++i)
+        m3_[s][i] += area_[nbr_[k]] * a[i >> 3] * a[(i >> 2) & 1] * a[(i >> 1) & 1] * g_[k](i & 1);
+    }
+  });
 
   // Reference mid-surface tangents G0, director gradient H0 and, per Gauss point, J0^-1 and the volume.
   K0_.resize(kGauss * n);
   vol_.resize(kGauss * n);
+  q3ref_.resize(n);
   b_.resize(nbr_.size());
   k_hg_.resize(nbr_.size());
   parallel_for(n, [&](std::size_t s) {
@@ -154,6 +179,8 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
       H0 += area_[t] * (N_[t] - N_[s]) * g_[k].transpose();
     }
     if (offset_[s] == offset_[s + 1]) G0 << T1_[s], T2_[s];
+    const Mat2 GH0 = G0.transpose() * H0;
+    q3ref_[s] = curvature_moment(-0.5 * (GH0 + GH0.transpose()), m3_[s]);
     const double det0 = columns(G0, N_[s]).determinant();
     const double* xi = sp.neo_hookean ? kXi3 : kXi2;
     const double* wq = sp.neo_hookean ? kW3 : kW2;
@@ -187,6 +214,7 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
   force_.assign(n, Vec3::Zero());
   torque_.assign(n, Vec3::Zero());
   F0_.assign(n, Mat3::Identity());
+  curv_.assign(n, Mat2::Zero());
   energy_.assign(n, 0.0);
   vm_.assign(n, 0.0);
   strain_.assign(n, 0.0);
@@ -219,6 +247,8 @@ void Shells::update(const Particles& P) {
     if (offset_[s] == offset_[s + 1]) G << T1_[s], T2_[s];
     G_[s] = G;
     H_[s] = H;
+    const Mat2 GH = G.transpose() * H;
+    curv_[s] = -0.5 * (GH + GH.transpose());
     F0_[s] = columns(G, d_[s]) * K0_[kGauss * s];
   });
   // Stress at the Gauss points, resultants and the energy's derivatives by G, H and d.
@@ -231,18 +261,30 @@ void Shells::update(const Particles& P) {
     double U = 0.0, vm = 0.0, strain = -1e300;
     Mat2 Nr = Mat2::Zero(), Mr = Mat2::Zero();
     Eigen::Vector2d Qr = Eigen::Vector2d::Zero();
+    // The membrane strain's curvature correction (docs/model.md "Shells", membrane locking): the linear
+    // gradient weights measure G with a third-order error whose tangential part, for a sheet bent without
+    // stretching, is G C with C = (Q(B0) - Q(B)) / 6 (Gauss-Codazzi in the reference's tangent-plane
+    // coordinates a: G_d . x_,abc = b0_dc b0_ab - b_dc b_ab); the metric then reads sym(C) too much, which
+    // the in-plane strain gives back. Zero for every rigid motion and every flat sheet bent in its plane;
+    // linear in the change of curvature on a curved sheet, where it is what locked the bending modes.
+    const Mat2& B = curv_[s];
+    const Mat2 C = (q3ref_[s] - curvature_moment(B, m3_[s])) / 6.0;
+    const Mat2 Csym = 0.5 * (C + C.transpose());
+    Mat2 Nt = Mat2::Zero();  // sum of V S (in-plane): dU / dC = -Nt
     const double* xi = sp.neo_hookean ? kXi3 : kXi2;
     for (int k = sp.neo_hookean ? 0 : 1; k < kGauss; ++k) {
       const double zeta = 0.5 * sp.t * xi[k];
       const Mat3& K = K0_[kGauss * s + k];
       const Mat3 F = columns(G_[s] + zeta * H_[s], d_[s]) * K;
       const Mat3 Eg = 0.5 * (F.transpose() * F - Mat3::Identity());
-      const Mat3 El = Q0.transpose() * Eg * Q0;
+      Mat3 El = Q0.transpose() * Eg * Q0;
+      El.topLeftCorner<2, 2>() -= Csym;
       Mat3 Sl;
       double psi = 0.0;
       shell_stress(sp, El, Sl, psi);
       const double V = vol_[kGauss * s + k];
       U += V * psi;
+      Nt += V * Sl.topLeftCorner<2, 2>();
       vm = std::max(vm, von_mises_plane(Sl));
       const double em = 0.5 * (El(0, 0) + El(1, 1)), ed = 0.5 * (El(0, 0) - El(1, 1));
       strain = std::max(strain, em + std::sqrt(ed * ed + El(0, 1) * El(0, 1)));
@@ -257,6 +299,24 @@ void Shells::update(const Particles& P) {
       PG += dJ.leftCols<2>();
       PH += zeta * dJ.leftCols<2>();
       q += dJ.col(2);
+    }
+    {  // dU/dB through C: dU = (1/6) sum_dl Nt_dl dQ_dl, dQ_dl = sum_abc (dB_dc B_ab + B_dc dB_ab) m3_abcl;
+       // then B = -sym(G^T H) gives dU/dG = -H T, dU/dH = -G T with T = sym(dU/dB).
+      const std::array<double, 16>& m3 = m3_[s];
+      Mat2 T = Mat2::Zero();
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b)
+          for (int c = 0; c < 2; ++c)
+            for (int l = 0; l < 2; ++l) {
+              const double m = m3[8 * a + 4 * b + 2 * c + l] / 6.0;
+              for (int d = 0; d < 2; ++d) {
+                T(d, c) += Nt(d, l) * B(a, b) * m;
+                T(a, b) += Nt(d, l) * B(d, c) * m;
+              }
+            }
+      const Mat2 Ts = 0.5 * (T + T.transpose());
+      PG -= H_[s] * Ts;
+      PH -= G_[s] * Ts;
     }
     PG_[s] = PG;
     PH_[s] = PH;
@@ -342,6 +402,7 @@ void Shells::advance_directors(double dt, double kick) {
     const double c = params_[material_[s]].damping;
     const Vec3 tau = external_.empty() ? torque_[s] : Vec3(torque_[s] + external_[s]);
     Vec3 w = omega_[s] + kick * (tau / inertia_[s] - c * omega_[s]);
+    if (support_[s] == 4) w -= w.dot(free_axis_[s]) * free_axis_[s];  // a hard diaphragm
     w -= w.dot(d_[s]) * d_[s];  // no spin about the director (it has no inertia, nothing to turn)
     omega_[s] = w;
     const double angle = w.norm() * dt;

@@ -28,11 +28,16 @@
 //     order for smooth ones, against the zig-zag modes that nodal integration cannot see; the part of eps
 //     along the pair's mean director is weighted by beta = min(1, 3 t^2 / |X_ij|^2), the bending scale (at
 //     the membrane's it locks thin sheets in bending; Shells::update, docs/validation.md "Shells");
+//   - the in-plane Green-Lagrange strain is corrected for the linear weights' third-order error on a curved
+//     sheet (the stencil's third moments times the change of Q(B) = B B, B = -sym(G^T H) the curvature;
+//     Shells::update, docs/model.md "Shells"): without it a cylinder bent without stretching stored 4.3x its
+//     bending energy at Delta x / t = 9.8 (membrane locking);
 //   - rotary inertia rho t^3 / 12 per area; mass rho t per area.
 // Neighbours are the reference neighbours of one body (found once); shells do not see the fluid yet.
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -134,7 +139,8 @@ class Shells {
 
   // For tests and validations: set the current director of slot s; an external moment on slot s [N m] (held
   // until changed); a support of slot s (0 free, 1 fixed, 2 pinned, 3 a diaphragm: the position held in the
-  // plane perpendicular to axis, free along it, the director free).
+  // plane perpendicular to axis, free along it, the director free; 4 the same with the director's rotation
+  // about axis held too, the "hard" simple support of a Mindlin shell).
   void set_director(std::size_t s, const Vec3& d) { d_[s] = d.normalized(); }
   void set_external_moment(std::size_t s, const Vec3& m) {
     if (external_.empty()) external_.assign(X_.size(), Vec3::Zero());
@@ -142,7 +148,7 @@ class Shells {
   }
   void set_support(std::size_t s, uint8_t support, const Vec3& axis = Vec3::UnitX()) {
     support_[s] = support;
-    if (support == 3) {
+    if (support == 3 || support == 4) {
       if (free_axis_.empty()) free_axis_.assign(X_.size(), Vec3::Zero());
       free_axis_[s] = axis.normalized();
     }
@@ -174,6 +180,11 @@ class Shells {
   std::vector<Eigen::Vector2d> g_;
   std::vector<Vec3> b_;
   std::vector<double> k_hg_;
+  // The membrane strain's curvature correction (Shells::update): per slot the stencil's third moments
+  // m3[a][b][c][l] = sum_t A_t a_a a_b a_c g_l (index 8 a + 4 b + 2 c + l) and Q(B0) of the reference
+  // curvature B0 = -sym(G0^T H0).
+  std::vector<std::array<double, 16>> m3_;
+  std::vector<Mat2> q3ref_;
   // Index maps.
   std::vector<uint32_t> at_, slot_, s_of_id_;
   // State.
@@ -184,6 +195,7 @@ class Shells {
   std::vector<Mat32> G_, H_, PG_, PH_;
   std::vector<Vec3> q_, hg_force_, force_, torque_;
   std::vector<Mat3> F0_;
+  std::vector<Mat2> curv_;  // B = -sym(G^T H), the current curvature in the reference tangent coordinates
   std::vector<double> energy_, vm_, strain_;
   std::vector<Mat2> Nres_, Mres_;
   std::vector<Eigen::Vector2d> Qres_;
