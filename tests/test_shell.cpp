@@ -774,15 +774,23 @@ TEST_CASE("shell validation: a cantilever strip under an end moment 2 pi E I / L
 TEST_CASE("shell validation: Scordelis-Lo roof, mid free-edge vertical displacement 0.3024",
           "[.shell-validation]") {
   // R = 25, L = 50, 80 degrees, t = 0.25, E = 4.32e8, nu = 0, gravity load 90 per area (rho 36, g 10); the
-  // curved ends on rigid diaphragms (held across the axis, free along it), the long edges free. 17 particles
-  // on the arc, 25 rows along (the end rows on the diaphragms at x = +-25). Damped to static.
+  // curved ends on rigid diaphragms (MacNeal & Harder 1985: held across the axis, free along it, and the
+  // rotation about the axis held), the long edges free. 17 particles on the arc, 25 rows along (the end rows
+  // on the diaphragms at x = +-25). Damped to static.
+  // The benchmark is linear. This model is not (Green-Lagrange strain, large rotations): at the full load the
+  // free edge sinks 1.2 t, the response is about 1 % stiffer than the linear one and it creeps to static far
+  // more slowly (docs/validation.md "Shells"); so the load is 1 % of the benchmark's and the displacements
+  // are scaled back. Diagnostics: ROOF_DIV (rows along: 24), ROOF_LOAD (the load's scale: 0.01), ROOF_SOFT
+  // (directors of the end rows free), ROOF_END (simulated time), ROOF_DAMPING, ROOF_HG, ROOF_PROFILE (a file
+  // for the mid-span profile, "deg uz" per line).
   const double R = 25, Lr = 50, dx = Lr / (std::getenv("ROOF_DIV") ? std::atof(std::getenv("ROOF_DIV")) : 24);
   Scene s;
   s.name = "roof";
   s.spacing = dx;
-  s.gravity = Vec3(0, 0, -10);
+  const double load = std::getenv("ROOF_LOAD") ? std::atof(std::getenv("ROOF_LOAD")) : 0.01;
+  s.gravity = Vec3(0, 0, -10 * load);
   s.domain = {Vec3(-40, -40, -40), Vec3(40, 40, 40)};
-  s.max_dt = 1.0;
+  s.max_dt = std::getenv("ROOF_MAXDT") ? std::atof(std::getenv("ROOF_MAXDT")) : 1.0;  // the World's step
   s.cfl = 0.5;
   Material m = shell_material(4.32e8, 0.0, 0.25, 36.0);
   m.shell_damping = std::getenv("ROOF_DAMPING") ? std::atof(std::getenv("ROOF_DAMPING")) : 12.0;
@@ -803,44 +811,55 @@ TEST_CASE("shell validation: Scordelis-Lo roof, mid free-edge vertical displacem
   Shells& sh = w.shells_for_test();
   for (std::size_t k = 0; k < sh.size(); ++k)
     if (std::abs(sh.reference(k).x()) > 0.5 * Lr - 0.25 * dx)
-      sh.set_support(k, std::getenv("ROOF_HARD") ? 4 : 3, Vec3::UnitX());  // ROOF_HARD: diagnostic
+      sh.set_support(k, std::getenv("ROOF_SOFT") ? 3 : 4, Vec3::UnitX());
   // The mid free edge: the particle nearest (0, R sin 40, R cos 40 - R).
   const double th = 40 * std::numbers::pi / 180;
   const std::size_t probe = nearest(w, Vec3(0, R * std::sin(th), R * std::cos(th) - R));
-  const double end = std::getenv("ROOF_END") ? std::atof(std::getenv("ROOF_END")) : 4.0;
-  double prev = 0.0;
-  for (int c = 1; c <= 8; ++c) {
-    w.advance_to(end * c / 8, [] { return true; });
-    const double uz = w.particles().x[probe].z() - w.particles().x0[probe].z();
-    WARN("roof t = " << w.time() << ": uz = " << uz << " (change " << uz - prev << "), steps " << w.steps());
+  const double end = std::getenv("ROOF_END") ? std::atof(std::getenv("ROOF_END")) : 3.0;
+  double prev = 0.0, change = 0.0;
+  for (int c = 1; c <= 6; ++c) {
+    w.advance_to(end * c / 6, [] { return true; });
+    const double uz = (w.particles().x[probe].z() - w.particles().x0[probe].z()) / load;
+    change = uz - prev;
+    WARN("roof t = " << w.time() << ": uz = " << uz << " (change " << change << "), steps " << w.steps());
     prev = uz;
   }
-  const double uz = w.particles().x[probe].z() - w.particles().x0[probe].z();
-  {  // The mid-span section's profile uz(angle) and its linear extrapolation from the two outer rows to 40
-     // deg.
-    const Particles& P = w.particles();
-    std::vector<std::pair<double, double>> prof;
-    for (std::size_t i = 0; i < P.size(); ++i)
-      if (std::abs(P.x0[i].x()) < 1e-6 && P.x0[i].y() > 0)
-        prof.emplace_back(std::atan2(P.x0[i].y(), P.x0[i].z() + R) * 180 / std::numbers::pi,
-                          P.x[i].z() - P.x0[i].z());
-    std::sort(prof.begin(), prof.end());
-    if (const char* path = std::getenv("ROOF_PROFILE")) {  // diagnostic: "deg uz" per line
-      std::ofstream f(path);
-      for (const auto& [a, u] : prof) f << a << " " << u << "\n";
-    }
-    std::ostringstream os;
-    for (const auto& [a, u] : prof) os << a << ":" << u << " ";
-    if (prof.size() >= 2) {
-      const auto& p1 = prof[prof.size() - 2];
-      const auto& p2 = prof.back();
-      os << "; extrapolated to 40 deg: "
-         << p2.second + (40 - p2.first) * (p2.second - p1.second) / (p2.first - p1.first);
-    }
-    WARN("Scordelis-Lo mid-span profile (deg:uz) " << os.str());
+  const double uz = prev;
+  CHECK(std::abs(change) < 1e-4 * std::abs(uz));  // static
+  // The mid-span section's profile uz(angle). The sheet's free edge is half a spacing beyond the outermost
+  // row (each particle carries the area around it), so the edge value is the profile's linear extrapolation
+  // from the two outer rows to 40 deg; on the continuum solution that extrapolation is within 0.5 % of the
+  // edge value at this spacing.
+  const Particles& P = w.particles();
+  std::vector<std::pair<double, double>> prof;
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (std::abs(P.x0[i].x()) < 1e-6 && P.x0[i].y() > 0)
+      prof.emplace_back(std::atan2(P.x0[i].y(), P.x0[i].z() + R) * 180 / std::numbers::pi,
+                        (P.x[i].z() - P.x0[i].z()) / load);
+  std::sort(prof.begin(), prof.end());
+  REQUIRE(prof.size() >= 2);
+  if (const char* path = std::getenv("ROOF_PROFILE")) {
+    std::ofstream f(path);
+    for (const auto& [a, u] : prof) f << a << " " << u << "\n";
   }
-  WARN("Scordelis-Lo: mid free-edge uz = " << uz << " at " << w.particles().x0[probe].transpose()
-                                           << ", reference -0.3024, ratio " << -uz / 0.3024 << ", "
-                                           << sh.size() << " particles");
-  CHECK(-uz == Approx(0.3024).epsilon(0.05));
+  const auto& p1 = prof[prof.size() - 2];
+  const auto& p2 = prof.back();
+  const double edge = p2.second + (40 - p2.first) * (p2.second - p1.second) / (p2.first - p1.first);
+  // The continuum's linear solution at the outermost row's angle: scripts/scordelis_lo_reference.py
+  // (Sanders-Koiter, Ritz; 0.3006 at the edge), uz at 30, 30.5, ..., 40 deg, interpolated.
+  const double ref[21] = {0.19206, 0.19780, 0.20352, 0.20921, 0.21488, 0.22052, 0.22612,
+                          0.23170, 0.23723, 0.24273, 0.24819, 0.25361, 0.25900, 0.26434,
+                          0.26964, 0.27490, 0.28012, 0.28530, 0.29044, 0.29554, 0.30060};
+  const double pos = std::clamp((p2.first - 30) / 0.5, 0.0, 19.999);
+  const int k = static_cast<int>(pos);
+  const double ref_at = ref[k] + (pos - k) * (ref[k + 1] - ref[k]);
+  std::ostringstream os;
+  for (const auto& [a, u] : prof) os << a << ":" << u << " ";
+  WARN("Scordelis-Lo mid-span profile (deg:uz) " << os.str());
+  WARN("Scordelis-Lo: outermost row at "
+       << p2.first << " deg: uz = " << p2.second << " (the probe's " << uz << "), continuum there " << -ref_at
+       << ", ratio " << -p2.second / ref_at << "; extrapolated to the edge " << edge << ", ratio to 0.3024 "
+       << -edge / 0.3024 << ", " << sh.size() << " particles");
+  CHECK(-edge == Approx(0.3024).epsilon(0.05));
+  CHECK(-p2.second == Approx(ref_at).epsilon(0.05));
 }
