@@ -302,13 +302,27 @@ TEST_CASE("shell: a cylinder bent without stretching (ring ovalization) carries 
 TEST_CASE("shell: internal forces and director moments are the energy's derivatives on a curved sheet",
           "[shell]") {
   // A deformed, sheared patch of a cylinder (R / t = 50): central differences of the energy against the
-  // forces and moments, for both materials (the curvature correction adds terms in G and H).
-  for (const bool neo : {false, true}) {
-    INFO((neo ? "neo-Hookean" : "Saint Venant-Kirchhoff"));
-    Cylinder c = cylinder(1.0, 48, 8, [](double x, double th) {
-      return Vec3(0.02 * std::sin(3 * th) + 0.01 * x, 0.03 * std::cos(2 * th) * (1 + x),
-                  0.05 * std::cos(th + x));
-    });
+  // forces and moments, for both materials (the curvature correction adds terms in G and H); and the same
+  // cylinder squashed into a flat oval with the directors along its normals, sharply bent at two ends, where
+  // the correction is saturated (Shells::update).
+  for (const auto& [neo, folded] : {std::pair{false, false}, {true, false}, {false, true}, {true, true}}) {
+    INFO((neo ? "neo-Hookean" : "Saint Venant-Kirchhoff") << (folded ? ", folded" : ""));
+    const double W = folded ? 0.6 : 0.0;
+    const auto disp = [W](double x, double th) {
+      return Vec3(0.02 * std::sin(3 * th) + 0.01 * x,
+                  0.03 * std::cos(2 * th) * (1 + x) - 0.5 * W * std::sin(2 * th),
+                  0.05 * std::cos(th + x) + W * std::cos(2 * th));
+    };
+    Cylinder c = cylinder(1.0, 48, 8, disp);
+    const auto normal_at = [&](const Vec3& X) {  // of the deformed surface, by central differences
+      const auto p = [&](double x, double th) {
+        const Vec3 er(0, std::sin(th), std::cos(th)), et(0, std::cos(th), -std::sin(th));
+        const Vec3 d = disp(x, th);
+        return Vec3(Vec3(x, 0, 0) + er + d.x() * Vec3::UnitX() + d.y() * et + d.z() * er);
+      };
+      const double x = X.x(), th = std::atan2(X.y(), X.z()), e = 1e-5;
+      return Vec3((p(x + e, th) - p(x - e, th)).cross(p(x, th + e) - p(x, th - e)).normalized());
+    };
     Material m = shell_material(1e6, 0.3, 0.02);
     m.neo_hookean = neo;
     const std::vector<Material> mats = {m};
@@ -317,7 +331,8 @@ TEST_CASE("shell: internal forces and director moments are the energy's derivati
     std::mt19937 rng(3);
     std::uniform_real_distribution<double> u(-1, 1);
     for (std::size_t s = 0; s < sh.size(); ++s)
-      sh.set_director(s, sh.reference_normal(s) + 0.05 * Vec3(u(rng), u(rng), u(rng)));
+      sh.set_director(s, (folded ? normal_at(sh.reference(s)) : sh.reference_normal(s)) +
+                             0.05 * Vec3(u(rng), u(rng), u(rng)));
     sh.update(c.P);
     double fmax = 0.0, tmax = 0.0;
     for (std::size_t s = 0; s < sh.size(); ++s) {
