@@ -31,7 +31,8 @@
 //   - the in-plane Green-Lagrange strain is corrected for the linear weights' third-order error on a curved
 //     sheet (the stencil's third moments times the change of Q(B) = B B, B = -sym(G^T H) the curvature;
 //     Shells::update, docs/model.md "Shells"): without it a cylinder bent without stretching stored 4.3x its
-//     bending energy at Delta x / t = 9.8 (membrane locking);
+//     bending energy at Delta x / t = 9.8 (membrane locking); saturated smoothly at 1 % of strain where a
+//     sheet folds within a few spacings and the series no longer holds;
 //   - rotary inertia rho t^3 / 12 per area; mass rho t per area.
 // Neighbours are the reference neighbours of one body (found once); shells do not see the fluid yet.
 #pragma once
