@@ -272,7 +272,7 @@ TEST_CASE("shell: a cylinder bent without stretching (ring ovalization) carries 
   // (v' + w) / R = 0): Kirchhoff-Love energy 1/2 D (3 W / R^2)^2 pi R L, no membrane energy. R / t = 100
   // and dx / t = 9.8 (64 round), as in the Scordelis-Lo roof at 17 on its arc. Without the membrane
   // strain's curvature correction (Shells::update) the discrete tangents' third-order error read as a hoop
-  // strain: 3.3 times the bending energy here (membrane locking; docs/validation.md "Shells").
+  // strain: 4.3 times the exact energy here (membrane locking; docs/validation.md "Shells").
   const double R = 25, t = 0.25, E = 4.32e8, W = 1e-4 * t;
   const int nth = 64, nx = 10;
   const double pi = std::numbers::pi, L = nx * 2 * pi * R / nth;

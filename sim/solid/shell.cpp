@@ -42,6 +42,13 @@ double von_mises_plane(const Mat3& S) {
 // The membrane correction's saturation: at most about this much strain (Shells::update).
 constexpr double kCorrectionMax = 0.01;
 
+// The curvature in the reference tangent coordinates, B = -sym(G^T H) (G the tangents, H the director
+// gradient).
+Shells::Mat2 curvature(const Shells::Mat32& G, const Shells::Mat32& H) {
+  const Shells::Mat2 GH = G.transpose() * H;
+  return -0.5 * (GH + GH.transpose());
+}
+
 // Q(B)_dl = sum_abc B_dc B_ab m3[abcl]: the tangential part of the third-order Taylor term that the linear
 // gradient weights leave in G (see Shells::update).
 Shells::Mat2 curvature_moment(const Shells::Mat2& B, const std::array<double, 16>& m3) {
@@ -182,8 +189,7 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
       H0 += area_[t] * (N_[t] - N_[s]) * g_[k].transpose();
     }
     if (offset_[s] == offset_[s + 1]) G0 << T1_[s], T2_[s];
-    const Mat2 GH0 = G0.transpose() * H0;
-    q3ref_[s] = curvature_moment(-0.5 * (GH0 + GH0.transpose()), m3_[s]);
+    q3ref_[s] = curvature_moment(curvature(G0, H0), m3_[s]);
     const double det0 = columns(G0, N_[s]).determinant();
     const double* xi = sp.neo_hookean ? kXi3 : kXi2;
     const double* wq = sp.neo_hookean ? kW3 : kW2;
@@ -217,7 +223,6 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
   force_.assign(n, Vec3::Zero());
   torque_.assign(n, Vec3::Zero());
   F0_.assign(n, Mat3::Identity());
-  curv_.assign(n, Mat2::Zero());
   energy_.assign(n, 0.0);
   vm_.assign(n, 0.0);
   strain_.assign(n, 0.0);
@@ -250,8 +255,6 @@ void Shells::update(const Particles& P) {
     if (offset_[s] == offset_[s + 1]) G << T1_[s], T2_[s];
     G_[s] = G;
     H_[s] = H;
-    const Mat2 GH = G.transpose() * H;
-    curv_[s] = -0.5 * (GH + GH.transpose());
     F0_[s] = columns(G, d_[s]) * K0_[kGauss * s];
   });
   // Stress at the Gauss points, resultants and the energy's derivatives by G, H and d.
@@ -274,7 +277,7 @@ void Shells::update(const Particles& P) {
     // coapting free edge) it is saturated smoothly at kCorrectionMax of strain, C_eff = s C with s = (1 +
     // (|C| / c0)^2)^(-1/2), so that it cannot swamp the strain it corrects (unsaturated, the closed leaflets
     // of aortic_valve_cycle_physio.json sped up to 32 m/s within 20 ms).
-    const Mat2& B = curv_[s];
+    const Mat2 B = curvature(G_[s], H_[s]);
     const Mat2 C = (q3ref_[s] - curvature_moment(B, m3_[s])) / 6.0;
     const Mat2 Cs = 0.5 * (C + C.transpose());
     const double cx = Cs.norm() / kCorrectionMax;

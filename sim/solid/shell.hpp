@@ -196,7 +196,6 @@ class Shells {
   std::vector<Mat32> G_, H_, PG_, PH_;
   std::vector<Vec3> q_, hg_force_, force_, torque_;
   std::vector<Mat3> F0_;
-  std::vector<Mat2> curv_;  // B = -sym(G^T H), the current curvature in the reference tangent coordinates
   std::vector<double> energy_, vm_, strain_;
   std::vector<Mat2> Nres_, Mres_;
   std::vector<Eigen::Vector2d> Qres_;
