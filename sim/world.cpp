@@ -270,7 +270,7 @@ World::World(const Scene& scene)
     for (const Material& m : scene_.materials)
       if (m.type == MaterialType::Shell) min_shell_thickness_ = std::min(min_shell_thickness_, m.thickness);
     if (have_fluid) {  // fluid on either side of a sheet (sim/boundary/shell_coupling.hpp)
-      coupling_ = ShellCoupling(P_, shells_, dx, kernel_.support, wall_ref_.rho0);
+      coupling_ = ShellCoupling(P_, shells_, sheets_.triangles(), dx, kernel_.support, wall_ref_.rho0);
       ctx_.shell_wall = &coupling_.wall();
       // The fluid's barrier modulus per material (ShellCoupling::barrier): the scene's factor of rho0 c0^2.
       if (scene_.contact.shell_fluid_barrier > 0.0)
@@ -456,7 +456,7 @@ void World::step(double dt) {
 
   t0 = Clock::now();
   integrate(dt);
-  if (coupling_.active()) coupling_.guard(P_, ctx_.periodic);  // no fluid particle through a sheet
+  if (coupling_.active()) coupling_.guard(P_, shells_, ctx_.periodic);  // no fluid particle through a sheet
   profile_.integrate += seconds_since(t0);
 
   // Open boundaries (sim/boundary/open_boundary.hpp): buffers move, particles that crossed an inlet or outlet

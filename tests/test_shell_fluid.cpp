@@ -449,6 +449,79 @@ std::pair<long, double> skim_free_edge(double barrier) {
 
 }  // namespace
 
+TEST_CASE("shell-fluid: water close to a curved sheet is on the sheet's side of it, not a tangent plane's",
+          "[shell_fluid]") {
+  // A clamped cylindrical panel (radius R = 5 dx, 150 degrees, directors outward) and, midway between two
+  // particles of its middle row and midway to the next row (0.71 dx from the four), water particles
+  // eps = 0.01 dx off the cylinder. Outside, the nearest
+  // particle's tangent plane has them inside (it leaves the cylinder by R (1 - cos(dtheta / 2)), about
+  // 0.025 dx, there); inside, a flat triangle through the particles has them outside (the chord is as far
+  // off). Until stop 37 the labels took the tangent plane's side, and a particle sliding along the outside
+  // of a curved leaflet changed label between two steps: the guard then put it back through the sheet.
+  const double dx = 0.01, R = 0.05, eps = 0.01 * dx;
+  Scene s = tank_scene("curved", dx, Vec3(0.1, 0.1, 0.1), 10.0, shell_sheet(1e6, 0.3, 0.2 * dx, 1000.0));
+  s.gravity = Vec3::Zero();
+  s.domain = {Vec3(-0.1, -0.1, -0.1), Vec3(0.1, 0.1, 0.1)};
+  s.max_density_error = 0.5;  // lone particles: their summed density is low, which is not what this is about
+  Body sheet;
+  sheet.name = "panel";
+  sheet.material = 2;
+  sheet.shape.kind = ShapeKind::CylindricalPanel;
+  sheet.shape.center = Vec3::Zero();
+  sheet.shape.axis = Vec3::UnitZ();
+  sheet.shape.radius = R;
+  sheet.shape.length = 0.1;
+  sheet.shape.angle = 150.0;
+  sheet.shape.normal = Vec3::UnitY();
+  sheet.shell_fixed = {Box{Vec3(-1, -1, -1), Vec3(1, 1, 1)}};
+  s.bodies = {sheet};
+  // The angles of the particles of the row nearest z = 0.
+  std::vector<double> angle;
+  double z_row = 1.0;
+  uint16_t body = 0;
+  {
+    const World w(s);
+    const Particles& P = w.particles();
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (P.kind[i] == Kind::Shell && std::abs(P.x[i].z()) < std::abs(z_row)) z_row = P.x[i].z();
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (P.kind[i] == Kind::Shell && std::abs(P.x[i].z() - z_row) < 1e-9) {
+        angle.push_back(std::atan2(P.x[i].y(), P.x[i].x()));
+        body = P.body[i];
+      }
+  }
+  std::sort(angle.begin(), angle.end());
+  REQUIRE(angle.size() >= 8);
+  // Water midway between neighbours (away from the panel's edges), outside and inside.
+  std::vector<Vec3> at;
+  for (std::size_t k = 2; k + 3 < angle.size(); ++k) {
+    const double mid = 0.5 * (angle[k] + angle[k + 1]);
+    const double r = k % 2 ? R + eps : R - eps;  // alternately (two at one place would overlap)
+    at.push_back(Vec3(r * std::cos(mid), r * std::sin(mid), z_row + 0.5 * dx));
+  }
+  for (std::size_t k = 0; k < at.size(); ++k)
+    s.bodies.push_back(box_body("water" + std::to_string(k), 0, at[k] - Vec3::Constant(0.5 * dx),
+                                at[k] + Vec3::Constant(0.5 * dx)));
+  World w(s);
+  w.advance_to(1e-4, [] { return true; });  // one step: its labels are those of the positions above
+  const Particles& P = w.particles();
+  int checked = 0, wrong = 0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    if (P.kind[i] != Kind::Fluid) continue;
+    const double r = std::hypot(P.x[i].x(), P.x[i].y());
+    const int side = w.shell_side(static_cast<uint32_t>(i), body);
+    ++checked;
+    if (side != (r > R ? 1 : -1)) {
+      ++wrong;
+      WARN("particle at r - R = " << (r - R) / dx << " dx labelled " << side);
+    }
+  }
+  INFO(checked << " particles checked, " << wrong << " on the wrong side; crossings " << w.shell_crossings());
+  CHECK(checked == static_cast<int>(at.size()));
+  CHECK(wrong == 0);
+  CHECK(w.shell_crossings() == 0);
+}
+
 TEST_CASE("shell-fluid: the barrier keeps water skimming a free edge's plane on its side", "[shell_fluid]") {
   // Beside a free edge the imaginary particles are beside the fluid particle, not under it, and a particle in
   // the sheet's plane has no pressure pushing it off: without the barrier the guard has to put it back.

@@ -2,13 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
+#include <utility>
 
 #include "core/kernel.hpp"
 #include "core/parallel.hpp"
 
 namespace aortasph {
 
-ShellCoupling::ShellCoupling(const Particles& P, const Shells& shells, double dx, double support,
+ShellCoupling::ShellCoupling(const Particles& P, const Shells& shells,
+                             const std::vector<std::array<uint32_t, 3>>& triangles, double dx, double support,
                              double rho_ref)
     : active_(!shells.empty()), dx_(dx), patch2_(0.64 * dx * dx) {
   wall_.dx = dx;
@@ -71,6 +75,50 @@ ShellCoupling::ShellCoupling(const Particles& P, const Shells& shells, double dx
     edge_slot_.push_back(static_cast<uint32_t>(s));
     edge_offset_.push_back(static_cast<uint32_t>(edge_nbr_.size()));
   }
+  build_guard_surface(n, triangles);
+}
+
+void ShellCoupling::build_guard_surface(std::size_t n,
+                                        const std::vector<std::array<uint32_t, 3>>& triangles) {
+  // Boundary edges: in one triangle only. Those between two edge particles get a skirt; any other is part of
+  // the outline (a hole).
+  std::map<std::pair<uint32_t, uint32_t>, int> uses;
+  for (const auto& t : triangles)
+    for (int m = 0; m < 3; ++m) ++uses[std::minmax(t[m], t[(m + 1) % 3])];
+  const auto boundary = [&](uint32_t i, uint32_t j) { return uses.at(std::minmax(i, j)) == 1; };
+  const auto skirted = [&](uint32_t i, uint32_t j) { return edge_[i] && edge_[j]; };
+  std::vector<uint8_t> open_slot(n, 0);
+  for (const auto& [e, c] : uses)
+    if (c == 1 && !skirted(e.first, e.second)) open_slot[e.first] = open_slot[e.second] = 1;
+  for (const auto& t : triangles) {
+    SheetTri T;
+    T.slot = t;
+    for (int m = 0; m < 3; ++m) {
+      const uint32_t i = t[(m + 1) % 3], j = t[(m + 2) % 3];  // the edge opposite vertex m
+      if (boundary(i, j) && !skirted(i, j)) T.open_edge |= static_cast<uint8_t>(1u << m);
+      if (open_slot[t[m]]) T.open_vertex |= static_cast<uint8_t>(1u << m);
+      if (boundary(i, j) && skirted(i, j)) {
+        // (i, j, j') and (i, j', i'): the outer edge j' i' is opposite vertex 0 of the second.
+        tris_.push_back(SheetTri{{i, j, j}, 4, 0, 4});
+        tris_.push_back(SheetTri{{i, j, i}, 6, 1, 6});
+      }
+    }
+    tris_.push_back(T);
+  }
+  // Incidence by slot (CSR), in the triangles' order.
+  const auto first = [](const SheetTri& T, int m) {  // the first vertex of T on its slot
+    return (m < 1 || T.slot[m] != T.slot[0]) && (m < 2 || T.slot[m] != T.slot[1]);
+  };
+  tri_offset_.assign(n + 1, 0);
+  for (const SheetTri& T : tris_)
+    for (int m = 0; m < 3; ++m)
+      if (first(T, m)) ++tri_offset_[T.slot[m] + 1];
+  for (std::size_t s = 0; s < n; ++s) tri_offset_[s + 1] += tri_offset_[s];
+  tri_of_.resize(tri_offset_[n]);
+  std::vector<uint32_t> fill(tri_offset_.begin(), tri_offset_.end() - 1);
+  for (std::size_t k = 0; k < tris_.size(); ++k)
+    for (int m = 0; m < 3; ++m)
+      if (first(tris_[k], m)) tri_of_[fill[tris_[k].slot[m]]++] = static_cast<uint32_t>(k);
 }
 
 void ShellCoupling::on_build(const Particles& P, NeighborSearch& nb) {
@@ -211,6 +259,17 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
         l.edge = edge_[static_cast<std::size_t>(shells.slot(j))];
       }
     }
+    // A fluid particle close to a sheet takes the side of the sheet's surface (closest_on_sheet), the one the
+    // guard checks: a tangent plane misjudges it on a curved sheet.
+    if (P.kind[i] == Kind::Fluid)
+      for (uint8_t q = 0; q < L.n; ++q) {
+        Label& l = L.l[q];
+        const Vec3 d = per.any ? per.image(P.x[i] - P.x[l.nearest]) : Vec3(P.x[i] - P.x[l.nearest]);
+        if (std::abs(wall_.normal[l.nearest].dot(d)) >= kGuardReach * dx_) continue;
+        const Closest c =
+            closest_on_sheet(P, shells, per, i, static_cast<std::size_t>(shells.slot(l.nearest)));
+        if (c.found && !c.outline && c.sigma != 0.0) l.side = c.sigma > 0.0 ? 1 : -1;
+      }
     labels_[r] = L;
     x_before_[r] = P.x[i];
     ShellWall::Sides& S = wall_.sides[i];
@@ -262,37 +321,30 @@ constexpr double kBarrier = 0.25;
 }  // namespace
 
 Vec3 ShellCoupling::barrier_pair(const Particles& P, const Shells& shells, const Periodic& per, uint32_t a,
-                                 uint32_t q, const Vec3& vq, double K) const {
+                                 const std::array<Gap, kLabels>& g, uint32_t q, const Vec3& vq,
+                                 double K) const {
   const long sl = shells.slot(q);
   if (sl < 0 || K <= 0.0) return Vec3::Zero();
   const std::size_t s = static_cast<std::size_t>(sl);
-  const Vec3& n = shells.director(s);  // the sheet's normal now (in a sub-step: as it has turned)
-  const Vec3 d = per.any ? per.image(P.x[a] - P.x[q]) : Vec3(P.x[a] - P.x[q]);
-  const double sn = n.dot(d);
-  // The side: a's label for q's sheet (where it was at the start of the step), else where it is.
-  int side = sn >= 0.0 ? 1 : -1;
-  const Labels& L = labels_[static_cast<std::size_t>(band_of_[a])];
-  for (uint8_t k = 0; k < L.n; ++k)
-    if (L.l[k].body == P.body[q]) side = L.l[k].side;
-  const double gap = side * sn;  // <= 0: across q's plane, the guard's business
+  const Gap* G = nullptr;
+  for (const Gap& x : g)
+    if (x.body == P.body[q] && x.gap > 0.0) G = &x;
+  if (G == nullptr) return Vec3::Zero();
   // The imaginary particles put the wall's surface at the mid-surface and fluid rests about dx / 2 off it
   // (a wall's first layer); the barrier sits inside that, whatever the sheet's own thickness.
   const double dc = kBarrier * dx_;
-  if (gap <= 0.0 || gap >= dc) return Vec3::Zero();
-  const Vec3 foot = d - sn * n;
-  const double rho = foot.norm();
+  // q's share: its area times the 2-D kernel at its distance from the closest point (a partition of unity
+  // over the sheet, so the pressure acts on about dx^2 of it).
+  const Vec3 qc = (per.any ? per.image(P.x[q] - P.x[a]) : Vec3(P.x[q] - P.x[a])) - G->c;
+  const double rho = qc.norm();
   if (rho >= 2.0 * dx_) return Vec3::Zero();
-  // Only over the sheet (its patches reach dx / 2 beyond the edge rows): beside a free edge the fluid passes
-  // round it.
-  if (!shells.over_sheet(s, foot, std::sqrt(0.5) * dx_)) return Vec3::Zero();
   const double w = dx_ * dx_ * shells.area(s) * cubic_spline_2d(rho, dx_);  // A_a A_q W2, A_a = dx^2
-  const Vec3 e = side * n;
-  const double rate = (P.v[a] - vq).dot(e);
+  const double rate = (P.v[a] - vq).dot(G->e);
   // Damper: half the critical damping of the spring K / d_c per area on the pair's reduced mass per area.
   const double mu_a = P.m[a] / (dx_ * dx_), mu_q = shells.mass(s) / shells.area(s);
   const double c = std::sqrt(K / dc * mu_a * mu_q / (mu_a + mu_q));
-  const double p = std::max(K * (1.0 - gap / dc) - c * rate, 0.0);
-  return (p * w) * e;
+  const double p = std::max(K * (1.0 - G->gap / dc) - c * rate, 0.0);
+  return (p * w) * G->e;
 }
 
 void ShellCoupling::barrier_begin(const Particles& P, const Shells& shells, const Periodic& per,
@@ -311,7 +363,9 @@ void ShellCoupling::barrier_begin(const Particles& P, const Shells& shells, cons
     const Vec3& n = shells.director(static_cast<std::size_t>(sl));
     const Vec3 d = per.any ? per.image(P.x[a] - P.x[q]) : Vec3(P.x[a] - P.x[q]);
     const double sn = n.dot(d);
-    if (std::abs(sn) >= dc + margin) return false;
+    // The surface may lie off q's tangent plane by up to (2 dx)^2 / 2R within the kernel's reach: half a
+    // spacing for R = 4 dx.
+    if (std::abs(sn) >= dc + 0.5 * dx_ + margin) return false;
     return (d - sn * n).squaredNorm() < (2.0 * dx_ + margin) * (2.0 * dx_ + margin);
   };
   const auto partner = [&](uint32_t i, uint32_t j) {
@@ -337,6 +391,9 @@ void ShellCoupling::barrier_begin(const Particles& P, const Shells& shells, cons
     }
   bar_.resize(bar_offset_.back());
   bar_impulse_.assign(bar_rows_.size(), Vec3::Zero());
+  bar_gap_.assign(bar_rows_.size(), {});
+  bar_of_band_.assign(nb, -1);
+  for (std::size_t k = 0; k < bar_rows_.size(); ++k) bar_of_band_[bar_rows_[k]] = static_cast<int32_t>(k);
   parallel_for(bar_rows_.size(), [&](std::size_t k) {
     const std::size_t r = bar_rows_[k];
     const uint32_t i = band_[r];
@@ -350,6 +407,25 @@ void ShellCoupling::barrier_substep(const Particles& P, const Shells& shells, co
                                     const std::vector<double>& K, const std::vector<Vec3>& shell_v, double h,
                                     std::vector<Vec3>& shell_force) {
   shell_force.assign(shells.size(), Vec3::Zero());
+  // The fluid rows' gaps to the sheets as they are now (a label's side; beyond a sheet's outline, or across
+  // it, none: the guard's business).
+  const double dc = kBarrier * dx_;
+  parallel_for(bar_rows_.size(), [&](std::size_t k) {
+    const std::size_t r = bar_rows_[k];
+    const uint32_t i = band_[r];
+    std::array<Gap, kLabels>& g = bar_gap_[k];
+    g = {};
+    if (P.kind[i] != Kind::Fluid) return;
+    const Labels& L = labels_[r];
+    for (uint8_t q = 0; q < L.n; ++q) {
+      const Label& l = L.l[q];
+      const Closest c = closest_on_sheet(P, shells, per, i, static_cast<std::size_t>(shells.slot(l.nearest)));
+      if (!c.found || c.outline) continue;
+      const double gap = l.side * c.sigma;
+      if (gap <= 0.0 || gap >= dc) continue;
+      g[q] = Gap{l.body, gap, -c.sigma * c.n, l.side * c.n};
+    }
+  });
   // Gather: each row sums its own pairs (the fluid particle over its shell partners, the shell particle over
   // its fluid partners), each pair computed as barrier_pair(fluid, shell) from both ends, so action =
   // reaction bit for bit and the sums do not depend on the thread count.
@@ -359,15 +435,17 @@ void ShellCoupling::barrier_substep(const Particles& P, const Shells& shells, co
     if (P.kind[i] == Kind::Fluid) {
       for (uint32_t m = bar_offset_[k]; m < bar_offset_[k + 1]; ++m) {
         const uint32_t q = bar_[m];
-        sum += barrier_pair(P, shells, per, i, q, shell_v[static_cast<std::size_t>(shells.slot(q))],
-                            K[P.material[i]]);
+        sum += barrier_pair(P, shells, per, i, bar_gap_[k], q,
+                            shell_v[static_cast<std::size_t>(shells.slot(q))], K[P.material[i]]);
       }
       bar_impulse_[k] += h * sum;
     } else {
       const std::size_t s = static_cast<std::size_t>(shells.slot(i));
       for (uint32_t m = bar_offset_[k]; m < bar_offset_[k + 1]; ++m) {
         const uint32_t a = bar_[m];
-        sum -= barrier_pair(P, shells, per, a, i, shell_v[s], K[P.material[a]]);
+        const int32_t ka = bar_of_band_[static_cast<std::size_t>(band_of_[a])];
+        sum -= barrier_pair(P, shells, per, a, bar_gap_[static_cast<std::size_t>(ka)], i, shell_v[s],
+                            K[P.material[a]]);
       }
       shell_force[s] = sum;
     }
@@ -381,21 +459,119 @@ void ShellCoupling::barrier_end(Particles& P, double dt) const {
   });
 }
 
-std::size_t ShellCoupling::guard(Particles& P, const Periodic& per) {
+namespace {
+
+// The point of triangle (a, b, c) closest to the origin, as barycentric weights; a weight is exactly 0 when
+// the point lies on the edge opposite its vertex (two zeros: on a vertex). Voronoi regions of the vertices,
+// then the edges, then the face (Ericson, Real-Time Collision Detection, 2005, section 5.1.5).
+std::array<double, 3> closest_to_origin(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a;
+  const double d1 = -ab.dot(a), d2 = -ac.dot(a);
+  if (d1 <= 0.0 && d2 <= 0.0) return {1.0, 0.0, 0.0};
+  const double d3 = -ab.dot(b), d4 = -ac.dot(b);
+  if (d3 >= 0.0 && d4 <= d3) return {0.0, 1.0, 0.0};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    const double v = d1 / (d1 - d3);
+    return {1.0 - v, v, 0.0};
+  }
+  const double d5 = -ab.dot(c), d6 = -ac.dot(c);
+  if (d6 >= 0.0 && d5 <= d6) return {0.0, 0.0, 1.0};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    const double w = d2 / (d2 - d6);
+    return {1.0 - w, 0.0, w};
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0.0, 1.0 - w, w};
+  }
+  const double den = 1.0 / (va + vb + vc);
+  const double v = vb * den, w = vc * den;
+  return {1.0 - v - w, v, w};
+}
+
+}  // namespace
+
+ShellCoupling::Closest ShellCoupling::closest_on_sheet(const Particles& P, const Shells& shells,
+                                                       const Periodic& per, uint32_t a, std::size_t s) const {
+  Closest out;
+  if (tris_.empty()) return out;
+  // The triangles touching s and those touching their vertices, each once, in ascending order.
+  thread_local std::vector<uint32_t> near;
+  near.clear();
+  for (uint32_t k = tri_offset_[s]; k < tri_offset_[s + 1]; ++k)
+    for (const uint32_t v : tris_[tri_of_[k]].slot)
+      near.insert(near.end(), tri_of_.begin() + tri_offset_[v], tri_of_.begin() + tri_offset_[v + 1]);
+  std::sort(near.begin(), near.end());
+  near.erase(std::unique(near.begin(), near.end()), near.end());
+  double best = std::numeric_limits<double>::infinity();
+  for (const uint32_t t : near) {
+    const SheetTri& T = tris_[t];
+    std::array<Vec3, 3> x, d;
+    for (int m = 0; m < 3; ++m) {
+      const uint32_t i = shells.at(T.slot[m]);
+      x[m] = per.any ? per.image(P.x[i] - P.x[a]) : Vec3(P.x[i] - P.x[a]);  // from the fluid particle
+      d[m] = shells.normal(T.slot[m]);  // the mid-surface's normal (a clamped director does not turn)
+      if (T.outer & (1u << m)) {        // the edge's outward direction in that tangent plane
+        const Vec3 o = edge_out_[i] - edge_out_[i].dot(d[m]) * d[m];
+        const double len = o.norm();
+        if (len > 0.0) x[m] += (0.5 * dx_ / len) * o;
+      }
+    }
+    if ((x[1] - x[0]).cross(x[2] - x[0]).squaredNorm() <= 1e-12 * dx_ * dx_ * dx_ * dx_)
+      continue;  // flat skirt
+    const std::array<double, 3> w = closest_to_origin(x[0], x[1], x[2]);
+    const Vec3 c = w[0] * x[0] + w[1] * x[1] + w[2] * x[2];
+    const double d2 = c.squaredNorm();
+    if (d2 >= best) continue;
+    best = d2;
+    const int zeros = (w[0] == 0.0) + (w[1] == 0.0) + (w[2] == 0.0);
+    bool outline = false;
+    for (int m = 0; m < 3; ++m) {
+      if (zeros == 1 && w[m] == 0.0) outline = T.open_edge & (1u << m);
+      if (zeros == 2 && w[m] != 0.0) outline = T.open_vertex & (1u << m);
+    }
+    const Vec3 n = (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]).normalized();
+    // The flat triangle is a chord of the curved sheet (dx^2 / 8R off it mid-edge, as far as a tangent plane
+    // half a spacing from its particle): the distance is taken to the Phong surface instead, the point c
+    // moved by alpha sum_m w_m ((x_m - c) . d_m) d_m (Boubekeur & Alexa, "Phong tessellation", ACM TOG 27(5),
+    // 2008), alpha = 1/2, which passes within O(dx^4 / R^3) of a circle through the particles.
+    double lift = 0.0;
+    for (int m = 0; m < 3; ++m) lift += w[m] * (x[m] - c).dot(d[m]) * n.dot(d[m]);
+    out = Closest{true, outline, -n.dot(c) - 0.5 * lift, n};  // the particle is at -c from c
+  }
+  return out;
+}
+
+std::size_t ShellCoupling::guard(Particles& P, const Shells& shells, const Periodic& per) {
   if (!active_) return 0;
   std::vector<uint8_t> moved(band_.size(), 0);
+  const double reach = kGuardReach * dx_;
   parallel_for(band_.size(), [&](std::size_t r) {
     const uint32_t a = band_[r];
     if (P.kind[a] != Kind::Fluid) return;
     const Labels& L = labels_[r];
     for (uint8_t q = 0; q < L.n; ++q) {
       const Label& l = L.l[q];
-      const Vec3& nrm = wall_.normal[l.nearest];
+      Vec3 nrm = wall_.normal[l.nearest];
       const Vec3 d = per.any ? per.image(P.x[a] - P.x[l.nearest]) : Vec3(P.x[a] - P.x[l.nearest]);
-      const double s = nrm.dot(d);
-      if (s * l.side > 0.0) continue;
-      // Near a free edge only a path through the sheet counts (round the edge is allowed).
-      if (l.edge && !segment_pierces(P, per, x_before_[r], P.x[a], static_cast<int32_t>(r), l.body)) continue;
+      double s = nrm.dot(d);
+      if (s * l.side > reach) continue;
+      const Closest c = closest_on_sheet(P, shells, per, a, static_cast<std::size_t>(shells.slot(l.nearest)));
+      if (c.found && !c.outline) {
+        // The side of the surface.
+        if (c.sigma * l.side > 0.0) continue;
+        nrm = c.n;
+        s = c.sigma;
+      } else {
+        // Beyond the outline: round an edge is allowed; in a hole of the sheet (an interior label), or with
+        // no triangles, the tangent plane decides (near an edge: a path through its patches).
+        if (s * l.side > 0.0 || (c.found && l.edge)) continue;
+        if (l.edge && !segment_pierces(P, per, x_before_[r], P.x[a], static_cast<int32_t>(r), l.body))
+          continue;
+      }
       P.x[a] += (l.side * 0.1 * dx_ - s) * nrm;
       if (per.any) per.wrap(P.x[a]);
       const double vr = (P.v[a] - P.v[l.nearest]).dot(nrm);

@@ -4,8 +4,10 @@
 //
 //  1. Side labels. Every particle whose neighbour list holds shell particles (fluid, walls, other bodies,
 //     and shell particles with respect to OTHER shell bodies) gets, per shell body B near it, a label: the
-//     nearest particle s of B and the side sigma = sign(n_s . (x - x_s)); the label is "at an edge" when s
-//     lies in the two or three rows along an edge of the sheet (free or supported).
+//     nearest particle s of B and the side sigma = sign(n_s . (x - x_s)) (a fluid particle within
+//     kGuardReach dx of that plane: the side of the sheet's surface, closest_on_sheet, as the guard below);
+//     the label is "at an edge" when s lies in the two or three rows along an edge of the sheet (free or
+//     supported).
 //  2. Masking. A pair (a, b) with a fluid particle in it is taken out of both neighbour lists for this step
 //     when it straddles a sheet: some body B labels a and b on opposite sides and, when both labels are
 //     interior, that is enough; near an edge the segment x_a -> x_b must also pierce B's sheet, i.e. cross
@@ -18,10 +20,16 @@
 //     lacks. The masked pairs move to the tail of their rows (NeighborSearch::set_end): every loop of the
 //     step skips them, and the rows are restored from the lists' build before each step, so the result does
 //     not depend on the history of the masks (checkpoints restart bitwise).
-//  3. Guard. After the drift, a fluid particle whose interior label flipped has crossed the sheet between
-//     two particles (near a free edge: whose path over the step pierced the sheet): it is put back on its
-//     side, 0.1 dx off the tangent plane, its velocity relative to the sheet along the normal removed, and
-//     counted (crossings(); the count stays 0 in every shipped scene).
+//  3. Guard. After the drift, a fluid particle near a sheet is checked against the sheet as a surface: the
+//     triangles through its particles (solid/shell_mesh.hpp) at their current positions, with a skirt dx / 2
+//     wide along every edge (where the sheet's patches end). The closest point c of that surface near the
+//     label's particle and the normal n there (the mid-surface normals interpolated) give its side,
+//     sign(n . (x - c)). A particle on the wrong side has crossed the sheet: it is put back on its side,
+//     0.1 dx off the surface along n, its velocity relative to the sheet along n removed, and counted
+//     (crossings()). A particle whose closest point is on the skirt's outer edge is beyond the sheet: it
+//     may pass round an edge. (Until stop 37 the side was that of the nearest particle's tangent plane,
+//     which a curved sheet leaves by d^2 / 2R at a distance d from the particle: in the physiological
+//     valve it put back particles that were on their own side of the sheet.)
 //
 // Only the rows of particles near a shell are touched (the "band", found at each list build): the cost is
 // proportional to the sheet's area, not to the fluid's volume.
@@ -44,7 +52,10 @@ class ShellCoupling {
   ShellCoupling() = default;
   // Edge particles of every shell body from the reference configuration; rho_ref: the walls' reference
   // density (the imaginary particles' mass), support: the fluid kernel's.
-  ShellCoupling(const Particles& P, const Shells& shells, double dx, double support, double rho_ref);
+  // triangles: the sheets' triangles by shell slot (ShellSheets), for the guard.
+  ShellCoupling(const Particles& P, const Shells& shells,
+                const std::vector<std::array<uint32_t, 3>>& triangles, double dx, double support,
+                double rho_ref);
 
   bool active() const { return active_; }
   // After each list build: the band rows and a copy of their pairs as built.
@@ -53,12 +64,14 @@ class ShellCoupling {
   // masks.
   void prepare(const Particles& P, const Shells& shells, NeighborSearch& nb, const Periodic& per);
   // After the drift: fluid particles that crossed a sheet are put back (see above). Returns how many.
-  std::size_t guard(Particles& P, const Periodic& per);
+  std::size_t guard(Particles& P, const Shells& shells, const Periodic& per);
   // The barrier (docs/model.md, "Fluid on both sides of a shell"): a fluid particle whose centre comes
   // within d_c = dx / 4 of a sheet's mid-surface (half its resting distance from a wall), on its own side and
   // over the sheet, is pushed back by a contact pressure p = K (1 - s / d_c) - c ds/dt (never pulling; s the
-  // gap to the shell particle's tangent plane, weighted over the patch like the shell contact,
-  // sim/solid/shell_contact.hpp), and the shell particle takes the opposite force. K per fluid material [Pa]
+  // gap to the sheet's surface, the guard's (closest_on_sheet), along its normal there; weighted over the
+  // shell particles round the closest point like the shell contact, sim/solid/shell_contact.hpp), and the
+  // shell particles take the opposite force. (Until stop 37 s was the gap to each shell particle's tangent
+  // plane, which on a curved sheet misses a particle near it.) K per fluid material [Pa]
   // (0: off). It is stiff for a light sheet (a 0.45 mm leaflet has half the mass per area of one fluid
   // particle), so it is evaluated in the shells' sub-steps (World::step_shells), not held over the fluid's
   // step: barrier_begin() once per step after prepare() (the labels) picks the pairs that can come within
@@ -75,6 +88,15 @@ class ShellCoupling {
 
   const ShellWall& wall() const { return wall_; }
 
+  // The side (+1 / -1) on which the last prepare() labelled particle i with respect to shell body `body`
+  // (0: no label).
+  int side(uint32_t i, uint16_t body) const {
+    if (i >= band_of_.size() || band_of_[i] < 0) return 0;
+    const Labels& L = labels_[static_cast<std::size_t>(band_of_[i])];
+    for (uint8_t q = 0; q < L.n; ++q)
+      if (L.l[q].body == body) return L.l[q].side;
+    return 0;
+  }
   long crossings() const { return crossings_; }
   void set_crossings(long c) { crossings_ = c; }
   std::size_t masked_pairs() const { return masked_; }
@@ -97,10 +119,43 @@ class ShellCoupling {
     uint8_t n = 0;
   };
 
+  // The guard's surface: the sheets' triangles and the skirt along their edges (two triangles per boundary
+  // edge (i, j): i, j, j' and i, j', i', where i' = x_i + dx / 2 times i's outward direction). A vertex is a
+  // slot, outward-shifted when its bit in `outer` is set; bit m of open_edge marks the edge opposite vertex m
+  // as the surface's outline (the skirt's outer edge; a boundary edge without a skirt), bit m of open_vertex
+  // vertex m as on the outline.
+  // The guard checks, and the labels of fluid particles take, the surface's side within this many spacings of
+  // the nearest particle's tangent plane (the surface leaves that plane by d^2 / 2R at a distance d from the
+  // particle: 0.1-0.3 mm at d = 0.6-0.9 mm in the folds by the aortic commissures at dx = 1 mm; at a quarter
+  // spacing, stop 37 saw labels from the plane and a guard from the surface disagree there).
+  static constexpr double kGuardReach = 0.5;
+  struct SheetTri {
+    std::array<uint32_t, 3> slot{};
+    uint8_t outer = 0, open_edge = 0, open_vertex = 0;
+  };
+  // The closest point of the guard's surface to fluid particle a, from the triangles round slot s (its
+  // triangles and their neighbours'): found, on the outline, the signed distance along the interpolated
+  // normal n, and n.
+  struct Closest {
+    bool found = false, outline = false;
+    double sigma = 0.0;
+    Vec3 n = Vec3::Zero();
+  };
+  void build_guard_surface(std::size_t n, const std::vector<std::array<uint32_t, 3>>& triangles);
+  Closest closest_on_sheet(const Particles& P, const Shells& shells, const Periodic& per, uint32_t a,
+                           std::size_t s) const;
   bool blocked(const Particles& P, const Periodic& per, uint32_t a, uint32_t b) const;
-  // The barrier's force on fluid particle a from shell particle q moving at vq (zero outside the barrier).
-  Vec3 barrier_pair(const Particles& P, const Shells& shells, const Periodic& per, uint32_t a, uint32_t q,
-                    const Vec3& vq, double K) const;
+  // A fluid particle's gap to each sheet near it in a sub-step (one per label): the closest point c (from
+  // the particle), the unit normal e towards the particle's side, and the gap along it (0: out of reach).
+  struct Gap {
+    uint16_t body = 0;
+    double gap = 0.0;
+    Vec3 c = Vec3::Zero(), e = Vec3::Zero();
+  };
+  // The barrier's force on fluid particle a (its gaps g) from shell particle q moving at vq (zero outside
+  // the barrier).
+  Vec3 barrier_pair(const Particles& P, const Shells& shells, const Periodic& per, uint32_t a,
+                    const std::array<Gap, kLabels>& g, uint32_t q, const Vec3& vq, double K) const;
   bool pierces(const Particles& P, const Periodic& per, uint32_t a, uint32_t b, uint16_t body) const;
   // Whether the segment xa -> xb crosses the sheet of `body` near the shell particles of band row `row`.
   bool segment_pierces(const Particles& P, const Periodic& per, const Vec3& xa, const Vec3& xb, int32_t row,
@@ -115,6 +170,8 @@ class ShellCoupling {
   std::vector<uint32_t> edge_slot_, edge_offset_, edge_nbr_;
   std::vector<double> edge_w_;
   std::vector<Vec3> edge_out_;
+  std::vector<SheetTri> tris_;
+  std::vector<uint32_t> tri_offset_, tri_of_;  // by slot: the triangles touching it (CSR)
   ShellWall wall_;
   // Band: rows holding a shell particle, their pairs as built (CSR) and their labels this step.
   std::vector<uint32_t> band_;    // particle indices
@@ -125,7 +182,9 @@ class ShellCoupling {
   // The barrier's candidate pairs this step (barrier_begin): band rows that have any (index into band_),
   // their partners (CSR), and the fluid rows' impulses summed over the sub-steps.
   std::vector<uint32_t> bar_rows_, bar_offset_, bar_;
+  std::vector<int32_t> bar_of_band_;  // by band row: index into bar_rows_, or -1
   std::vector<Vec3> bar_impulse_;
+  std::vector<std::array<Gap, kLabels>> bar_gap_;  // by bar row (fluid rows): this sub-step's gaps
   long crossings_ = 0;
   std::size_t masked_ = 0;
 };
