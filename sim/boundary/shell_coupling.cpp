@@ -260,15 +260,22 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
       }
     }
     // A fluid particle close to a sheet takes the side of the sheet's surface (closest_on_sheet), the one the
-    // guard checks: a tangent plane misjudges it on a curved sheet.
+    // guard checks: a tangent plane misjudges it on a curved sheet. Further off, the side of the plane of
+    // the mid-surface's normal there (not the director's: a clamped director does not turn with its sheet).
     if (P.kind[i] == Kind::Fluid)
       for (uint8_t q = 0; q < L.n; ++q) {
         Label& l = L.l[q];
         const Vec3 d = per.any ? per.image(P.x[i] - P.x[l.nearest]) : Vec3(P.x[i] - P.x[l.nearest]);
-        if (std::abs(wall_.normal[l.nearest].dot(d)) >= kGuardReach * dx_) continue;
+        const double sm = shells.normal(static_cast<std::size_t>(shells.slot(l.nearest))).dot(d);
+        if (std::abs(sm) >= kGuardReach * dx_) {
+          l.side = sm >= 0.0 ? 1 : -1;
+          continue;
+        }
         const Closest c =
             closest_on_sheet(P, shells, per, i, static_cast<std::size_t>(shells.slot(l.nearest)));
-        if (c.found && !c.outline && c.sigma != 0.0) l.side = c.sigma > 0.0 ? 1 : -1;
+        // (Beyond the outline too: the side of the sheet's extension, which the guard judges once the
+        // particle comes back over the sheet.)
+        if (c.found && c.sigma != 0.0) l.side = c.sigma > 0.0 ? 1 : -1;
       }
     labels_[r] = L;
     x_before_[r] = P.x[i];
@@ -558,7 +565,7 @@ std::size_t ShellCoupling::guard(Particles& P, const Shells& shells, const Perio
       Vec3 nrm = wall_.normal[l.nearest];
       const Vec3 d = per.any ? per.image(P.x[a] - P.x[l.nearest]) : Vec3(P.x[a] - P.x[l.nearest]);
       double s = nrm.dot(d);
-      if (s * l.side > reach) continue;
+      if (shells.normal(static_cast<std::size_t>(shells.slot(l.nearest))).dot(d) * l.side > reach) continue;
       const Closest c = closest_on_sheet(P, shells, per, a, static_cast<std::size_t>(shells.slot(l.nearest)));
       if (c.found && !c.outline) {
         // The side of the surface.
