@@ -4,10 +4,10 @@
 //
 //  1. Side labels. Every particle whose neighbour list holds shell particles (fluid, walls, other bodies,
 //     and shell particles with respect to OTHER shell bodies) gets, per shell body B near it, a label: the
-//     nearest particle s of B and the side sigma = sign(n_s . (x - x_s)) (a fluid particle within
-//     kGuardReach dx of that plane: the side of the sheet's surface, closest_on_sheet, as the guard below);
-//     the label is "at an edge" when s lies in the two or three rows along an edge of the sheet (free or
-//     supported).
+//     nearest particle s of B and the side sigma = sign(n_s . (x - x_s)) (a fluid particle: n_s the
+//     mid-surface normal, and within kGuardReach dx of that plane the side of the sheet's surface,
+//     closest_on_sheet, as the guard below, beyond the sheet's outline too); the label is "at an edge" when
+//     s lies in the two or three rows along an edge of the sheet (free or supported).
 //  2. Masking. A pair (a, b) with a fluid particle in it is taken out of both neighbour lists for this step
 //     when it straddles a sheet: some body B labels a and b on opposite sides and, when both labels are
 //     interior, that is enough; near an edge the segment x_a -> x_b must also pierce B's sheet, i.e. cross
