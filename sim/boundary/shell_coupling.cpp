@@ -266,13 +266,13 @@ void ShellCoupling::prepare(const Particles& P, const Shells& shells, NeighborSe
       for (uint8_t q = 0; q < L.n; ++q) {
         Label& l = L.l[q];
         const Vec3 d = per.any ? per.image(P.x[i] - P.x[l.nearest]) : Vec3(P.x[i] - P.x[l.nearest]);
-        const double sm = shells.normal(static_cast<std::size_t>(shells.slot(l.nearest))).dot(d);
+        const std::size_t sl = static_cast<std::size_t>(shells.slot(l.nearest));
+        const double sm = shells.normal(sl).dot(d);
         if (std::abs(sm) >= kGuardReach * dx_) {
           l.side = sm >= 0.0 ? 1 : -1;
           continue;
         }
-        const Closest c =
-            closest_on_sheet(P, shells, per, i, static_cast<std::size_t>(shells.slot(l.nearest)));
+        const Closest c = closest_on_sheet(P, shells, per, i, sl);
         // (Beyond the outline too: the side of the sheet's extension, which the guard judges once the
         // particle comes back over the sheet.)
         if (c.found && c.sigma != 0.0) l.side = c.sigma > 0.0 ? 1 : -1;
@@ -342,7 +342,7 @@ Vec3 ShellCoupling::barrier_pair(const Particles& P, const Shells& shells, const
   const double dc = kBarrier * dx_;
   // q's share: its area times the 2-D kernel at its distance from the closest point (a partition of unity
   // over the sheet, so the pressure acts on about dx^2 of it).
-  const Vec3 qc = (per.any ? per.image(P.x[q] - P.x[a]) : Vec3(P.x[q] - P.x[a])) - G->c;
+  const Vec3 qc = (per.any ? per.image(P.x[q] - P.x[a]) : Vec3(P.x[q] - P.x[a])) + G->gap * G->e;
   const double rho = qc.norm();
   if (rho >= 2.0 * dx_) return Vec3::Zero();
   const double w = dx_ * dx_ * shells.area(s) * cubic_spline_2d(rho, dx_);  // A_a A_q W2, A_a = dx^2
@@ -430,7 +430,7 @@ void ShellCoupling::barrier_substep(const Particles& P, const Shells& shells, co
       if (!c.found || c.outline) continue;
       const double gap = l.side * c.sigma;
       if (gap <= 0.0 || gap >= dc) continue;
-      g[q] = Gap{l.body, gap, -c.sigma * c.n, l.side * c.n};
+      g[q] = Gap{l.body, gap, l.side * c.n};
     }
   });
   // Gather: each row sums its own pairs (the fluid particle over its shell partners, the shell particle over
@@ -565,8 +565,9 @@ std::size_t ShellCoupling::guard(Particles& P, const Shells& shells, const Perio
       Vec3 nrm = wall_.normal[l.nearest];
       const Vec3 d = per.any ? per.image(P.x[a] - P.x[l.nearest]) : Vec3(P.x[a] - P.x[l.nearest]);
       double s = nrm.dot(d);
-      if (shells.normal(static_cast<std::size_t>(shells.slot(l.nearest))).dot(d) * l.side > reach) continue;
-      const Closest c = closest_on_sheet(P, shells, per, a, static_cast<std::size_t>(shells.slot(l.nearest)));
+      const std::size_t sl = static_cast<std::size_t>(shells.slot(l.nearest));
+      if (shells.normal(sl).dot(d) * l.side > reach) continue;
+      const Closest c = closest_on_sheet(P, shells, per, a, sl);
       if (c.found && !c.outline) {
         // The side of the surface.
         if (c.sigma * l.side > 0.0) continue;

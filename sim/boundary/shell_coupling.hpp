@@ -145,12 +145,13 @@ class ShellCoupling {
   Closest closest_on_sheet(const Particles& P, const Shells& shells, const Periodic& per, uint32_t a,
                            std::size_t s) const;
   bool blocked(const Particles& P, const Periodic& per, uint32_t a, uint32_t b) const;
-  // A fluid particle's gap to each sheet near it in a sub-step (one per label): the closest point c (from
-  // the particle), the unit normal e towards the particle's side, and the gap along it (0: out of reach).
+  // A fluid particle's gap to each sheet near it in a sub-step (one per label): the unit normal e towards
+  // the particle's side and the gap along it (0: out of reach); the closest point is at -gap e from the
+  // particle.
   struct Gap {
     uint16_t body = 0;
     double gap = 0.0;
-    Vec3 c = Vec3::Zero(), e = Vec3::Zero();
+    Vec3 e = Vec3::Zero();
   };
   // The barrier's force on fluid particle a (its gaps g) from shell particle q moving at vq (zero outside
   // the barrier).
