@@ -448,7 +448,10 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     j["particles"] = {{"total", world.particles().size()},
                       {"fluid", world.count(Kind::Fluid)},
                       {"boundary", world.particles().size() - world.count(Kind::Fluid)}};
-    j["time"] = {{"simulated", world.time()}, {"steps", world.steps()}, {"frames", frame}};
+    j["time"] = {{"simulated", world.time()},
+                 {"steps", world.steps()},
+                 {"frames", frame},
+                 {"neighbour_list_builds", world.list_builds()}};
     if (!world.shells().empty())  // fluid particles put back on their side of a sheet (0 when it holds)
       j["shells"] = {{"particles", world.shells().size()},
                      {"fluid_crossings", world.shell_crossings()},

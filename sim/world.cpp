@@ -283,6 +283,7 @@ World::World(const Scene& scene)
 
   // Spatial sort once, so neighbours sit close in memory from the first step.
   skin_ = 0.1 * kernel_.support;
+  open_.set_list_reach(kernel_.support + skin_);
   nb_.bin(P_.x, kernel_.support);  // the cells alone: spatial_order() needs no lists
   permute(nb_.spatial_order());
   build_lists();
@@ -366,6 +367,11 @@ void World::update_neighbors() {
 
 void World::build_lists() {
   const double radius = kernel_.support + skin_;
+  // Buffer particles that left past a far face since the last build (OpenBoundaries::update) go now.
+  if (!open_.empty() && open_.remove_departed(P_) > 0) {
+    solids_.reindex(P_);
+    shells_.reindex(P_);
+  }
   if (builds_ % sort_every_builds_ == sort_every_builds_ - 1) {
     // The sort needs only each particle's cell (bin(), as the constructor's first sort), not a full list
     // build whose lists the permutation would discard.
@@ -378,7 +384,19 @@ void World::build_lists() {
   coupling_.on_build(P_, nb_);  // the rows near a shell, as built
   ++builds_;
   record_build_positions(P_.x);
+  listed_ = P_.size();
   lists_valid_ = true;
+}
+
+// Particles appended by the open boundaries at a deep buffer's far face (OpenBoundaries::update): empty rows
+// until the next build, nobody's neighbour, their positions watched for the skin like the others'.
+void World::append_to_lists(std::size_t first) {
+  nb_.append_rows(P_.size() - first);
+  coupling_.on_append(P_.size());
+  for (std::size_t i = first; i < P_.size(); ++i) {
+    skin_index_.push_back(static_cast<uint32_t>(i));
+    x_at_build_.push_back(P_.x[i]);
+  }
 }
 
 // Memory (docs/performance.md): on the dam-break bench two thirds of the particles are walls, so keeping the
@@ -461,12 +479,19 @@ void World::step(double dt) {
 
   // Open boundaries (sim/boundary/open_boundary.hpp): buffers move, particles that crossed an inlet or outlet
   // disc change role, are created at inflows and removed at outflows (those never count as leaving the
-  // domain). Created or removed particles invalidate the neighbour lists.
+  // domain). Particles created or removed where the fluid could see them invalidate the neighbour lists;
+  // those at the far face of a deep buffer wait for the next build (issue 18 item 1).
   t0 = Clock::now();
-  if (!open_.empty() && open_.update(P_, nb_, kernel_, gravity_, time_ + dt, dt)) {
-    lists_valid_ = false;
-    solids_.reindex(P_);  // particles were appended and removed: the solid's slots follow (by particle id)
-    shells_.reindex(P_);
+  if (!open_.empty()) {
+    const std::size_t before = P_.size();
+    const OpenBoundaryChange change = open_.update(P_, nb_, kernel_, gravity_, time_ + dt, dt);
+    if (change.rebuild) {
+      lists_valid_ = false;
+      solids_.reindex(P_);  // particles were appended and removed: the solid's slots follow (by particle id)
+      shells_.reindex(P_);
+    } else if (P_.size() > before) {
+      append_to_lists(before);
+    }
   }
   profile_.open_boundary += seconds_since(t0);
 
@@ -760,17 +785,19 @@ void World::check_and_remove(double dt) {
     }
   }
 
-  // Particles that leave the domain are removed; more than the allowed fraction is an instability.
+  // Particles that leave the domain are removed; more than the allowed fraction is an instability. (Buffer
+  // particles departed past a far face are removed at the next list build, wherever they are.)
   const Box& dom = scene_.domain;
+  auto inside = [&](std::size_t i) { return dom.contains(P_.x[i]) || OpenBoundaries::departed(P_, i); };
   const std::size_t outside = parallel_reduce(
-      n, std::size_t{0}, [&](std::size_t i) { return std::size_t{!dom.contains(P_.x[i])}; },
+      n, std::size_t{0}, [&](std::size_t i) { return std::size_t{!inside(i)}; },
       [](std::size_t a, std::size_t b) { return a + b; });
   if (outside == 0) return;
   std::vector<uint32_t> keep;
   keep.reserve(n - outside);
   std::size_t first_out = n;
   for (std::size_t i = 0; i < n; ++i) {
-    if (dom.contains(P_.x[i]))
+    if (inside(i))
       keep.push_back(static_cast<uint32_t>(i));
     else if (first_out == n)
       first_out = i;
@@ -884,6 +911,10 @@ void World::save_state(StateWriter& out) const {
   nb.value(lists_valid_);
   nb.value(builds_);
   nb.array(lists_valid_ ? build_positions() : std::vector<Vec3>{});
+  if (lists_valid_ && listed_ < P_.size()) {  // particles appended since the build (append_to_lists)
+    SectionWriter& nr = out.section("neighbor_rows", 1);
+    nr.value(static_cast<uint64_t>(listed_));
+  }
 }
 
 void World::load_state(const StateReader& in) {
@@ -985,7 +1016,20 @@ void World::load_state(const StateReader& in) {
   nb.done();
   if (lists_valid_) {
     if (x_at_build.size() != n) nb.mismatch("x_at_build", x_at_build.size(), n);
-    nb_.build(x_at_build, kernel_.support + skin_, fixed_mask());
+    // The lists as built: over the particles that existed then, those appended since with empty rows.
+    listed_ = n;
+    if (in.has("neighbor_rows")) {
+      SectionReader nr = in.section("neighbor_rows");
+      listed_ = static_cast<std::size_t>(nr.value<uint64_t>());
+      nr.done();
+      if (listed_ > n) nr.mismatch("listed particles", listed_, n);
+    }
+    std::vector<uint8_t> fixed = fixed_mask();
+    fixed.resize(listed_);
+    nb_.build(
+        std::vector<Vec3>(x_at_build.begin(), x_at_build.begin() + static_cast<std::ptrdiff_t>(listed_)),
+        kernel_.support + skin_, fixed);
+    nb_.append_rows(n - listed_);
     coupling_.on_build(P_, nb_);
     record_build_positions(x_at_build);
   }

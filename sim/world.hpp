@@ -166,6 +166,9 @@ class World {
   long steps() const { return steps_; }
   double last_dt() const { return last_dt_; }
   long list_builds() const { return builds_; }
+  // Whether the neighbour lists describe the current particles (false after a change of the particle set
+  // that asks for a rebuild: the next step's first act).
+  bool lists_current() const { return lists_valid_; }
   double max_speed() const { return max_speed_; }
   double speed_limit() const { return speed_limit_; }
   std::size_t count(Kind k) const;
@@ -190,6 +193,7 @@ class World {
  private:
   void update_neighbors();
   void build_lists();
+  void append_to_lists(std::size_t first);  // particles first.. appended by the open boundaries
   std::vector<uint8_t> fixed_mask() const;  // 1 for particles that never move (walls)
   void integrate(double dt);
   // The velocity update's length for a step of dt (see integrate()): dt on the first step, else the mean of
@@ -261,6 +265,8 @@ class World {
   // full array (walls at their position), as before.
   std::vector<Vec3> x_at_build_;
   std::vector<uint32_t> skin_index_;
+  // Particles 0 .. listed_ - 1 are in the lists; those appended since the last build have empty rows.
+  std::size_t listed_ = 0;
   void record_build_positions(const std::vector<Vec3>& x);
   void jitter_points(std::vector<Vec3>& points, std::size_t b, double amplitude) const;  // Body::jitter
   std::vector<Vec3> build_positions() const;  // every particle's, walls included

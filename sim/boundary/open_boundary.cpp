@@ -23,7 +23,8 @@ enum Action : uint8_t {
   kInflowToFluid,   // crossed the inlet disc: becomes fluid, a new buffer particle is created behind
   kFluidToOutflow,  // crossed the outlet disc
   kOutflowToFluid,  // came back across the outlet disc
-  kRemove,          // passed the outflow buffer's far face
+  kRemove,          // passed the outflow buffer's far face, or left a buffer sideways
+  kDepart,          // passed a deep buffer's far face: mass 0, removed at the next list build
   kRemoveBackflow,  // fluid that flowed back into an inflow buffer
   kFluidToInflow,   // fluid that crossed a pressure inlet's disc backwards
 };
@@ -289,7 +290,7 @@ void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) {
     flows_[k].pressure = slab[k].vol > 0.0 ? slab[k].pv / slab[k].vol : fluid_.at(z.material).p_background;
   }
   parallel_for(n, [&](std::size_t i) {
-    if (P.kind[i] != Kind::Inflow && P.kind[i] != Kind::Outflow) return;
+    if ((P.kind[i] != Kind::Inflow && P.kind[i] != Kind::Outflow) || departed(P, i)) return;
     const int k = zone_of(P.x[i], P.kind[i]);
     if (k < 0) return;
     const Zone& z = zones_[k];
@@ -313,9 +314,9 @@ void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) {
   });
 }
 
-bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicSpline& K, const Vec3& gravity,
-                            double t_new, double dt) {
-  if (zones_.empty()) return false;
+OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicSpline& K,
+                                          const Vec3& gravity, double t_new, double dt) {
+  if (zones_.empty()) return {};
   const std::size_t n = P.size();
 
   // A step that starts at an output time (a multiple of time.output_interval) starts a new averaging interval
@@ -343,7 +344,9 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
   };
   std::vector<Item> order;
   for (std::size_t i = 0; i < n; ++i)
-    if (P.kind[i] == Kind::Outflow) {
+    if (departed(P, i)) {
+      continue;
+    } else if (P.kind[i] == Kind::Outflow) {
       if (const int k = zone_of(P.x[i], Kind::Outflow); k >= 0)
         order.push_back({zones_[k].axial(P.x[i]), static_cast<uint32_t>(i), k});
     } else if (P.kind[i] == Kind::Inflow) {
@@ -379,6 +382,7 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
   std::vector<int> zone(n, -1);  // inflow particles: their zone
   parallel_for(n, [&](std::size_t i) {
     const Kind kind = P.kind[i];
+    if (departed(P, i)) return;  // waits, at rest and without mass, for the next list build
     if (kind == Kind::Inflow) {
       const int k = zone_of(P.x[i], Kind::Inflow);
       zone[i] = k;
@@ -395,8 +399,10 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
         const double a = z.axial(P.x[i]);
         if (a >= 0.0)
           action[i] = kInflowToFluid;
-        else if (a < -z.depth || z.radial(P.x[i]) > z.spec.radius + 0.5 * dx_)
+        else if (z.radial(P.x[i]) > z.spec.radius + 0.5 * dx_)
           action[i] = kRemove;
+        else if (a < -z.depth)
+          action[i] = defers(z) ? kDepart : kRemove;
         return;
       }
       double speed = z.inflow_speed(P.x[i], t_new);
@@ -410,9 +416,15 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
       P.x[i] += dt * P.v[i];
       if (z.axial(P.x[i]) >= 0.0) action[i] = kInflowToFluid;
     } else if (kind == Kind::Outflow) {
+      const int k0 = zone_of(P.x[i], Kind::Outflow);
       P.v_wall[i] = P.v[i];
       P.a[i] = Vec3::Zero();
       P.x[i] += dt * P.v[i];
+      if (k0 >= 0 && zones_[k0].axial(P.x[i]) > zones_[k0].depth &&
+          zones_[k0].radial(P.x[i]) <= zones_[k0].spec.radius + 0.5 * dx_) {
+        action[i] = defers(zones_[k0]) ? kDepart : kRemove;  // beyond the far face
+        return;
+      }
       const int k = zone_of(P.x[i], Kind::Outflow);
       zone[i] = k;
       if (k < 0) {
@@ -469,6 +481,7 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
 
   // One serial pass in index order: the sums, the new particles' order and ids do not depend on threads.
   std::size_t removed = 0, created = 0;
+  bool rebuild = false;
   for (std::size_t i = 0; i < n; ++i) {
     switch (action[i]) {
       case kNone:
@@ -506,6 +519,7 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
         P.material[j] = P.material[i];
         P.id[j] = state_.next_id++;
         ++created;
+        if (!defers(z)) rebuild = true;
         break;
       }
       case kFluidToOutflow:
@@ -518,6 +532,12 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
       case kRemove:
         ++removed;
         break;
+      case kDepart:
+        P.m[i] = 0.0;
+        P.v[i] = Vec3::Zero();
+        P.v_wall[i] = Vec3::Zero();
+        P.a[i] = Vec3::Zero();
+        break;
       case kRemoveBackflow:
         state_.volume_out += P.m[i] / P.rho[i];
         state_.mass_out += P.m[i];
@@ -528,6 +548,7 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
   state_.created += created;
   state_.removed += removed;
   if (removed > 0) {
+    rebuild = true;
     std::vector<uint32_t> keep;
     keep.reserve(P.size() - removed);
     for (std::size_t i = 0; i < P.size(); ++i)
@@ -568,7 +589,20 @@ bool OpenBoundaries::update(Particles& P, const NeighborSearch& nb, const CubicS
     f.wave_p = std::exp(-dt / z.spec.non_reflecting_tau) * f.wave_p + (f.pressure - f.wave_ref);
     f.wave_ref = f.pressure;
   }
-  return created > 0 || removed > 0;
+  return {created, rebuild};
+}
+
+std::size_t OpenBoundaries::remove_departed(Particles& P) {
+  std::vector<uint32_t> keep;
+  keep.reserve(P.size());
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (!departed(P, i)) keep.push_back(static_cast<uint32_t>(i));
+  const std::size_t removed = P.size() - keep.size();
+  if (removed > 0) {
+    P.permute(keep);
+    state_.removed += removed;
+  }
+  return removed;
 }
 
 }  // namespace aortasph

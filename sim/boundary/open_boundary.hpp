@@ -68,6 +68,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/kernel.hpp"
@@ -102,6 +103,13 @@ struct OpenBoundaryFlow {
   double wave_p = 0.0;
 };
 
+// What OpenBoundaries::update did to the particle set.
+struct OpenBoundaryChange {
+  std::size_t created = 0;  // particles appended at the end of the arrays
+  bool rebuild = false;     // the caller must rebuild its neighbour lists (particles removed, or created
+                            // where a fluid particle could reach them before the lists' next rebuild)
+};
+
 class OpenBoundaries {
  public:
   OpenBoundaries() = default;
@@ -119,10 +127,28 @@ class OpenBoundaries {
 
   // The stage of the step, after the fluid has been integrated to t_new = t + dt: buffers move, particles
   // that crossed a disc change role, are created or removed, and the buffers' state is imposed for t_new.
-  // nb: the neighbour lists of this step (still valid: nothing has moved more than half the skin). Returns
-  // true when particles were created or removed (the caller must rebuild its neighbour lists).
-  bool update(Particles& P, const NeighborSearch& nb, const CubicSpline& K, const Vec3& gravity, double t_new,
-              double dt);
+  // nb: the neighbour lists of this step (still valid: nothing has moved more than half the skin).
+  // Buffers deeper than the lists' reach (set_list_reach; issue 18 item 1) change the particle set without a
+  // rebuild: a particle created at a buffer's far face is appended (the caller gives it an empty row until
+  // its next rebuild), and a particle that leaves past a far face is not removed but "departed": its mass
+  // and velocity are set to 0, so it takes part in no sum, and it waits for the caller's next list build
+  // (remove_departed). Neither can come within a kernel support of a fluid particle before then: the buffer
+  // lies between them, at least support + skin deep. Elsewhere (shallow buffers, a particle leaving a
+  // buffer sideways, backflow removed at a velocity inlet) particles are removed at once and the change asks
+  // for a rebuild.
+  OpenBoundaryChange update(Particles& P, const NeighborSearch& nb, const CubicSpline& K, const Vec3& gravity,
+                            double t_new, double dt);
+
+  // The caller's neighbour-list search radius (kernel support + Verlet skin) [m]; unset, every change of the
+  // particle set asks for a rebuild.
+  void set_list_reach(double r) { list_reach_ = r; }
+  // A buffer particle that left past a far face and waits for removal (see update()).
+  static bool departed(const Particles& P, std::size_t i) {
+    return P.m[i] == 0.0 && (P.kind[i] == Kind::Inflow || P.kind[i] == Kind::Outflow);
+  }
+  // Removes the departed particles, the others keeping their order; returns how many were removed. Call it
+  // just before a neighbour-list build.
+  std::size_t remove_departed(Particles& P);
 
   // Sum over inflows of the prescribed volume flow rate V(t) A [m^3/s], A = the inlet's particle columns
   // times spacing^2 (the cross-section that the particles really feed).
@@ -168,6 +194,13 @@ class OpenBoundaries {
     // Pressure inlet or outflow: the pressure is prescribed, the velocity carried from the fluid.
     bool pressure_driven() const { return spec.type == OpenBoundaryType::Outflow || spec.pressure_inlet; }
   };
+  // Whether zone z's buffer is deep enough that particles created at or leaving past its far face need no
+  // rebuild (update()): the fluid nearest the far face (a velocity inlet lets backflow a spacing deep)
+  // stays farther than the lists' reach, with a tenth of a spacing for the step's motion.
+  bool defers(const Zone& z) const {
+    const bool velocity_inlet = z.spec.type == OpenBoundaryType::Inflow && !z.spec.pressure_inlet;
+    return z.depth >= list_reach_ + (velocity_inlet ? 1.1 : 0.1) * dx_;
+  }
 
   // Index of the zone whose buffer holds particle x of the given kind, or -1.
   int zone_of(const Vec3& x, Kind kind) const;
@@ -191,6 +224,7 @@ class OpenBoundaries {
   double dx_ = 0.0;
   double support_ = 0.0;
   double output_interval_ = 0.0;
+  double list_reach_ = std::numeric_limits<double>::infinity();
   OpenBoundaryState state_;
   std::vector<OpenBoundaryFlow> flows_;
   double interval_start_ = 0.0;

@@ -60,6 +60,11 @@ class ShellCoupling {
   bool active() const { return active_; }
   // After each list build: the band rows and a copy of their pairs as built.
   void on_build(const Particles& P, NeighborSearch& nb);
+  // Particles appended since (World::append_to_lists: open-boundary buffers, far from any sheet): outside
+  // the band. n: the new particle count.
+  void on_append(std::size_t n) {
+    if (active_) band_of_.resize(n, -1);
+  }
   // Before the fluid sums of a step: the imaginary particles' normals and masses, the side labels and the
   // masks.
   void prepare(const Particles& P, const Shells& shells, NeighborSearch& nb, const Periodic& per);

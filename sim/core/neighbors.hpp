@@ -25,6 +25,13 @@ class NeighborSearch {
   // Only the cell grid and each particle's cell, as build() makes them, without the lists: enough for
   // spatial_order(), at a fraction of the cost and memory. The lists are left empty (size() == 0).
   void bin(const std::vector<Vec3>& x, double radius);
+  // Adds count particles at the end with empty rows (nobody's neighbour either) until the next build.
+  void append_rows(std::size_t count) {
+    for (std::size_t k = 0; k < count; ++k) {
+      offset_.push_back(offset_.back());
+      if (!row_end_.empty()) row_end_.push_back(offset_.back());
+    }
+  }
   // Frees every buffer (lists and cell grid), keeping the periodic axes.
   void release();
   void set_periodic(const Periodic& p) { periodic_ = p; }
