@@ -192,7 +192,8 @@ TEST_CASE("study: an interrupted study finishes only the missing variant, resume
   }
   ::setpgid(pid, pid);
   std::string done, running;
-  for (int k = 0; k < 2000 && running.empty(); ++k) {
+  // Up to 3 minutes: the first variant takes about 10 s on a quiet machine, several times that on a loaded one.
+  for (int k = 0; k < 18000 && running.empty(); ++k) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     done.clear();
     for (const char* id : {"v000", "v001"}) {
