@@ -126,6 +126,16 @@ Scene tube_scene(const TubeSetup& t) {
   return s;
 }
 
+// A short tube (8 spacings) already flowing at 0.1 m/s with a parabolic inflow: particles are created and
+// removed from the first steps.
+TubeSetup flowing_short_tube() {
+  TubeSetup t;
+  t.parabolic = true;
+  t.initial_velocity = 0.1;
+  t.length_dx = 8;
+  return t;
+}
+
 struct Row {
   double t, q_mid, volume_in, volume_out, volume_inside, prescribed, mass_in, mass_out, mass_inside, p_out,
       p_in;
@@ -353,10 +363,7 @@ TEST_CASE("tube flow: identical probes and state for 1 and 2 threads", "[open][d
 
 TEST_CASE("tube flow: a checkpoint carries the created particles and the boundary counters",
           "[open][checkpoint]") {
-  TubeSetup t;
-  t.parabolic = true;
-  t.initial_velocity = 0.1;
-  t.length_dx = 8;
+  TubeSetup t = flowing_short_tube();
   const Scene s = tube_scene(t);
   World a(s);
   a.advance_to(0.004, [] { return true; });
@@ -434,10 +441,7 @@ TEST_CASE(
   // inflow's new particles get empty rows and the outflow's leaving ones wait, massless, for the next build
   // (when some particle has moved half the skin). Two layers: every such step rebuilds, as before. Either
   // way no pair within the support may be missing from the lists.
-  TubeSetup t;
-  t.parabolic = true;
-  t.initial_velocity = 0.1;
-  t.length_dx = 8;
+  TubeSetup t = flowing_short_tube();
   World deep(tube_scene(t));
   const ListAudit a = audit_lists(deep, 150);
   t.layers = 2;
@@ -457,10 +461,7 @@ TEST_CASE(
 
 TEST_CASE("open boundaries: a checkpoint taken with particles not yet listed resumes bitwise",
           "[open][checkpoint]") {
-  TubeSetup t;
-  t.parabolic = true;
-  t.initial_velocity = 0.1;
-  t.length_dx = 8;
+  TubeSetup t = flowing_short_tube();
   const Scene s = tube_scene(t);
   World a(s);
   // Step until a step appended particles without a build: the lists then have empty rows at the end.
