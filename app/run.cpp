@@ -455,6 +455,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     if (!world.shells().empty())  // fluid particles put back on their side of a sheet (0 when it holds)
       j["shells"] = {{"particles", world.shells().size()},
                      {"fluid_crossings", world.shell_crossings()},
+                     {"label_disagreements", world.shell_label_disagreements()},
                      {"masked_pairs", world.shell_masked_pairs()},
                      {"rim_particles", world.shell_rim_particles()}};
     j["timings_s"] = {{"setup", setup_seconds},

@@ -474,7 +474,8 @@ void World::step(double dt) {
 
   t0 = Clock::now();
   integrate(dt);
-  if (coupling_.active()) coupling_.guard(P_, shells_, ctx_.periodic);  // no fluid particle through a sheet
+  if (coupling_.active())
+    coupling_.guard(P_, shells_, ctx_.periodic, dt);  // no fluid particle through a sheet
   profile_.integrate += seconds_since(t0);
 
   // Open boundaries (sim/boundary/open_boundary.hpp): buffers move, particles that crossed an inlet or outlet
@@ -905,6 +906,10 @@ void World::save_state(StateWriter& out) const {
   if (coupling_.active()) {  // a section of its own: older checkpoints and shell-free scenes lack it
     SectionWriter& sc = out.section("shell_coupling", 1);
     sc.value(coupling_.crossings());
+    if (coupling_.label_disagreements() > 0) {  // a section of its own: older checkpoints lack it
+      SectionWriter& sd = out.section("shell_label_disagreements", 1);
+      sd.value(coupling_.label_disagreements());
+    }
   }
 
   SectionWriter& nb = out.section("neighbors", 1);
@@ -1037,6 +1042,11 @@ void World::load_state(const StateReader& in) {
     SectionReader sc = in.section("shell_coupling");
     coupling_.set_crossings(sc.value<long>());
     sc.done();
+  }
+  if (in.has("shell_label_disagreements")) {
+    SectionReader sd = in.section("shell_label_disagreements");
+    coupling_.set_label_disagreements(sd.value<long>());
+    sd.done();
   }
 
   // The solid's reference configuration is rebuilt from the scene (it never changes); only its map from

@@ -143,6 +143,7 @@ class World {
   // Fluid on both sides of the shells (sim/boundary/shell_coupling.hpp): fluid particles put back on their
   // side of a sheet since t = 0 (0 when the coupling holds), and the pairs masked in the last step.
   long shell_crossings() const { return coupling_.crossings(); }
+  long shell_label_disagreements() const { return coupling_.label_disagreements(); }
   // The side of shell body `body` on which the last step found particle i (ShellCoupling::side).
   int shell_side(uint32_t i, uint16_t body) const { return coupling_.side(i, body); }
   // Shell sub-cycling (World::step_shells): shell sub-steps taken since t = 0, the number in the last step,

@@ -141,6 +141,7 @@ TEST_CASE("shell-fluid: a clamped stiff sheet holds a 10 kPa difference without 
                   << " Pa; crossings " << world.shell_crossings() << ", masked pairs "
                   << world.shell_masked_pairs() << ", steps " << world.steps());
   CHECK(world.shell_crossings() == 0);
+  CHECK(world.shell_label_disagreements() == 0);  // a flat sheet: labels and surface agree
   CHECK(wrong_side(world, 0, false) == 0);
   CHECK(wrong_side(world, 1, true) == 0);
   CHECK(world.shell_masked_pairs() > 0);
@@ -254,6 +255,7 @@ TEST_CASE("shell-fluid: a plate between two water columns deflects by the net lo
                             << world.shell_crossings() << ", particles on the wrong side " << wrong
                             << ", steps " << world.steps());
   CHECK(world.shell_crossings() == 0);
+  CHECK(world.shell_label_disagreements() == 0);
   CHECK(wrong == 0);
   CHECK(std::abs(w_wet / w_ref - 1.0) < 0.10);
 }

@@ -552,9 +552,9 @@ ShellCoupling::Closest ShellCoupling::closest_on_sheet(const Particles& P, const
   return out;
 }
 
-std::size_t ShellCoupling::guard(Particles& P, const Shells& shells, const Periodic& per) {
+std::size_t ShellCoupling::guard(Particles& P, const Shells& shells, const Periodic& per, double dt) {
   if (!active_) return 0;
-  std::vector<uint8_t> moved(band_.size(), 0);
+  std::vector<uint8_t> moved(band_.size(), 0), disagree(band_.size(), 0);
   const double reach = kGuardReach * dx_;
   parallel_for(band_.size(), [&](std::size_t r) {
     const uint32_t a = band_[r];
@@ -569,8 +569,13 @@ std::size_t ShellCoupling::guard(Particles& P, const Shells& shells, const Perio
       if (shells.normal(sl).dot(d) * l.side > reach) continue;
       const Closest c = closest_on_sheet(P, shells, per, a, sl);
       if (c.found && !c.outline) {
-        // The side of the surface.
+        // The side of the surface; a crossing of this step is no deeper than the step's motion.
         if (c.sigma * l.side > 0.0) continue;
+        const Vec3 step = per.any ? per.image(P.x[a] - x_before_[r]) : Vec3(P.x[a] - x_before_[r]);
+        if (-c.sigma * l.side > step.norm() + dt * P.v[l.nearest].norm() + 0.02 * dx_) {
+          disagree[r] = 1;
+          continue;
+        }
         nrm = c.n;
         s = c.sigma;
       } else {
@@ -590,6 +595,7 @@ std::size_t ShellCoupling::guard(Particles& P, const Shells& shells, const Perio
   std::size_t count = 0;
   for (const uint8_t m : moved) count += m;
   crossings_ += static_cast<long>(count);
+  for (const uint8_t m : disagree) disagreements_ += m;
   return count;
 }
 

@@ -27,9 +27,15 @@
 //     sign(n . (x - c)). A particle on the wrong side has crossed the sheet: it is put back on its side,
 //     0.1 dx off the surface along n, its velocity relative to the sheet along n removed, and counted
 //     (crossings()). A particle whose closest point is on the skirt's outer edge is beyond the sheet: it
-//     may pass round an edge. (Until stop 37 the side was that of the nearest particle's tangent plane,
-//     which a curved sheet leaves by d^2 / 2R at a distance d from the particle: in the physiological
-//     valve it put back particles that were on their own side of the sheet.)
+//     may pass round an edge. A crossing made in the step is no deeper than the step's motion: where the
+//     surface puts a particle on the wrong side deeper than its own displacement plus the sheet's (dt |v| of
+//     the label's particle) plus dx / 50, the particle did not cross in this step; the label and the surface
+//     disagree (beside an edge two surface elements can lie at nearly the same distance with different
+//     normals, and the signed distance, the normal component of x - c, flips between them). Such a particle
+//     is left where it is, not teleported through the sheet, and counted apart (label_disagreements()); the
+//     next step labels it from the surface. (Until stop 37 the side was that of the nearest particle's
+//     tangent plane, which a curved sheet leaves by d^2 / 2R at a distance d from the particle: in the
+//     physiological valve it put back particles that were on their own side of the sheet.)
 //
 // Only the rows of particles near a shell are touched (the "band", found at each list build): the cost is
 // proportional to the sheet's area, not to the fluid's volume.
@@ -68,8 +74,9 @@ class ShellCoupling {
   // Before the fluid sums of a step: the imaginary particles' normals and masses, the side labels and the
   // masks.
   void prepare(const Particles& P, const Shells& shells, NeighborSearch& nb, const Periodic& per);
-  // After the drift: fluid particles that crossed a sheet are put back (see above). Returns how many.
-  std::size_t guard(Particles& P, const Shells& shells, const Periodic& per);
+  // After the drift of a step dt: fluid particles that crossed a sheet are put back (see above). Returns how
+  // many.
+  std::size_t guard(Particles& P, const Shells& shells, const Periodic& per, double dt);
   // The barrier (docs/model.md, "Fluid on both sides of a shell"): a fluid particle whose centre comes
   // within d_c = dx / 4 of a sheet's mid-surface (half its resting distance from a wall), on its own side and
   // over the sheet, is pushed back by a contact pressure p = K (1 - s / d_c) - c ds/dt (never pulling; s the
@@ -104,6 +111,9 @@ class ShellCoupling {
   }
   long crossings() const { return crossings_; }
   void set_crossings(long c) { crossings_ = c; }
+  // Particles the guard found on the wrong side deeper than the step could have taken them (see above).
+  long label_disagreements() const { return disagreements_; }
+  void set_label_disagreements(long c) { disagreements_ = c; }
   std::size_t masked_pairs() const { return masked_; }
   std::size_t rim_particles() const {
     std::size_t c = 0;
@@ -192,6 +202,7 @@ class ShellCoupling {
   std::vector<Vec3> bar_impulse_;
   std::vector<std::array<Gap, kLabels>> bar_gap_;  // by bar row (fluid rows): this sub-step's gaps
   long crossings_ = 0;
+  long disagreements_ = 0;
   std::size_t masked_ = 0;
 };
 
