@@ -368,10 +368,8 @@ void World::update_neighbors() {
 void World::build_lists() {
   const double radius = kernel_.support + skin_;
   // Buffer particles that left past a far face since the last build (OpenBoundaries::update) go now.
-  if (!open_.empty() && open_.remove_departed(P_) > 0) {
-    solids_.reindex(P_);
-    shells_.reindex(P_);
-  }
+  if (!open_.empty())
+    if (const std::vector<uint32_t> keep = open_.take_departed(P_); !keep.empty()) permute(keep);
   if (builds_ % sort_every_builds_ == sort_every_builds_ - 1) {
     // The sort needs only each particle's cell (bin(), as the constructor's first sort), not a full list
     // build whose lists the permutation would discard.

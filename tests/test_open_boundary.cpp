@@ -392,8 +392,8 @@ namespace {
 // of those, the ones that kept their lists (deferred), and the list builds.
 struct ListAudit {
   int steps_changing = 0, deferred = 0, builds = 0, audited = 0;
-  std::size_t missing =
-      0;  // fluid particles' pairs within the support absent from the lists, all audited steps
+  // Fluid particles' pairs within the support absent from the lists, over all audited steps.
+  std::size_t missing = 0;
 };
 
 std::size_t count_departed(const Particles& P) {

@@ -592,17 +592,14 @@ OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb
   return {created, rebuild};
 }
 
-std::size_t OpenBoundaries::remove_departed(Particles& P) {
+std::vector<uint32_t> OpenBoundaries::take_departed(const Particles& P) {
   std::vector<uint32_t> keep;
   keep.reserve(P.size());
   for (std::size_t i = 0; i < P.size(); ++i)
     if (!departed(P, i)) keep.push_back(static_cast<uint32_t>(i));
-  const std::size_t removed = P.size() - keep.size();
-  if (removed > 0) {
-    P.permute(keep);
-    state_.removed += removed;
-  }
-  return removed;
+  if (keep.size() == P.size()) return {};
+  state_.removed += P.size() - keep.size();
+  return keep;
 }
 
 }  // namespace aortasph

@@ -132,7 +132,7 @@ class OpenBoundaries {
   // rebuild: a particle created at a buffer's far face is appended (the caller gives it an empty row until
   // its next rebuild), and a particle that leaves past a far face is not removed but "departed": its mass
   // and velocity are set to 0, so it takes part in no sum, and it waits for the caller's next list build
-  // (remove_departed). Neither can come within a kernel support of a fluid particle before then: the buffer
+  // (take_departed). Neither can come within a kernel support of a fluid particle before then: the buffer
   // lies between them, at least support + skin deep. Elsewhere (shallow buffers, a particle leaving a
   // buffer sideways, backflow removed at a velocity inlet) particles are removed at once and the change asks
   // for a rebuild.
@@ -146,9 +146,9 @@ class OpenBoundaries {
   static bool departed(const Particles& P, std::size_t i) {
     return P.m[i] == 0.0 && (P.kind[i] == Kind::Inflow || P.kind[i] == Kind::Outflow);
   }
-  // Removes the departed particles, the others keeping their order; returns how many were removed. Call it
-  // just before a neighbour-list build.
-  std::size_t remove_departed(Particles& P);
+  // The order that drops the departed particles, the others keeping theirs (for the caller's permute, just
+  // before a neighbour-list build), counted as removed; empty when none departed.
+  std::vector<uint32_t> take_departed(const Particles& P);
 
   // Sum over inflows of the prescribed volume flow rate V(t) A [m^3/s], A = the inlet's particle columns
   // times spacing^2 (the cross-section that the particles really feed).
