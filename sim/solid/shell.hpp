@@ -40,6 +40,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "core/kernel.hpp"
@@ -113,6 +114,21 @@ class Shells {
     for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k)
       if ((sep(x_[nbr_[k]], x_[s]) - r).squaredNorm() <= r2) return true;
     return false;
+  }
+  // Of the particle s and its reference neighbours, the one (slot) whose position at the last update() lies
+  // nearest to the point x_s + r, and its offset from x_s: the patch of the sheet that point faces.
+  std::pair<std::size_t, Vec3> nearest_patch(std::size_t s, const Vec3& r) const {
+    std::pair<std::size_t, Vec3> best{s, Vec3::Zero()};
+    double d2 = r.squaredNorm();
+    for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+      const Vec3 o = sep(x_[nbr_[k]], x_[s]);
+      const double e2 = (r - o).squaredNorm();
+      if (e2 < d2) {
+        d2 = e2;
+        best = {nbr_[k], o};
+      }
+    }
+    return best;
   }
   const Vec3& torque(std::size_t s) const { return torque_[s]; }
   // Internal force of the last update() on slot s [N] (what add_forces() adds).

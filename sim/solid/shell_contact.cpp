@@ -72,20 +72,38 @@ ShellContact::Pair ShellContact::pair(const Particles& P, const Shells& sh, std:
   // Particle o against the tangent plane of shell particle q (slot s); d = x_o - x_q, v = v_o - v_q.
   // Returns the force on o.
   const auto term = [&](long s, const Vec3& d, const Vec3& v) -> Vec3 {
-    const Vec3& n = sh.director(slot(s));
-    const double sn = d.dot(n);
-    const double g = std::abs(sn);
-    if (g >= 2.0 * dc) return Vec3::Zero();
-    const double rho = std::sqrt(std::max(d.squaredNorm() - sn * sn, 0.0));
+    const Vec3& nq = sh.director(slot(s));
+    const double snq = d.dot(nq);
+    const double rho = std::sqrt(std::max(d.squaredNorm() - snq * snq, 0.0));  // the weight's distance
     if (rho >= 2.0 * dx) return Vec3::Zero();
+    // Against a wall or elastic particle o, the sheet near o is the patch o faces (the one of q and its
+    // neighbours nearest to o), not q's tangent plane, which is off the sheet by about rho^2 / 2R at rho on a
+    // curved sheet. The gap is the larger of o's distance to the two planes, the direction that of the
+    // patch: where q's plane passes through o away from the sheet (a commissure post 1.8 mm from a
+    // leaflet's corner particle, the leaflet curving away from it), q's gap alone was ~0 and changed side
+    // with each pass of a post particle, flipping a barrier of up to 1000 K, and the leaflet blew up at
+    // peak ejection (aortic_valve_cycle_physio.json at 0.2043 s, docs/validation.md); the patch's gap alone
+    // keeps pushing q while q moves off (8.9 ms into that scene: the patch, by the wall, did not move), and
+    // q's plane, carried away with it, bounds that. Between two sheets q's own plane (their shares, above,
+    // handle edge on).
+    std::size_t ps = slot(s);
+    Vec3 dp = d;
+    if (!(a_shell && b_shell)) {
+      const auto [t, off] = sh.nearest_patch(ps, d);
+      ps = t;
+      dp = d - off;
+    }
+    const Vec3& n = sh.director(ps);
+    const double sn = dp.dot(n);
+    const double g = std::max(std::abs(sn), std::abs(snq));
+    if (g >= 2.0 * dc) return Vec3::Zero();
     // A wall or elastic particle whose foot on the plane, x_o - s n, lies beyond an edge of the sheet (not
     // within dx / sqrt(2) of a particle of it: the patches of a lattice of spacing dx cover the sheet out to
     // dx / 2 beyond its edge rows) is not over the sheet: edge on, it sits near the plane of the particles
     // along the edge, whose gap says nothing about the contact (two sheets share such a pair by their gaps,
     // above). Without this, a wall particle in the plane of a free edge (a commissure post) set a barrier
     // stiffness without bound and a step of 1e-8 s.
-    if (!(a_shell && b_shell) && !sh.over_sheet(slot(s), d - sn * n, std::sqrt(0.5) * dx))
-      return Vec3::Zero();
+    if (!(a_shell && b_shell) && !sh.over_sheet(ps, dp - sn * n, std::sqrt(0.5) * dx)) return Vec3::Zero();
     const double w = weight * area_a * area_b * cubic_spline_2d(rho, dx);
     const Vec3 e = sn >= 0.0 ? n : Vec3(-n);  // from q's plane towards o
     const double rate = v.dot(e);             // d(gap)/dt
