@@ -155,6 +155,7 @@ class ShellCoupling {
     bool found = false, outline = false;
     double sigma = 0.0;
     Vec3 n = Vec3::Zero();
+    Vec3 c = Vec3::Zero();  // the closest point of the flat triangles, from the particle
   };
   void build_guard_surface(std::size_t n, const std::vector<std::array<uint32_t, 3>>& triangles);
   Closest closest_on_sheet(const Particles& P, const Shells& shells, const Periodic& per, uint32_t a,
