@@ -420,14 +420,14 @@ namespace {
 // (docs/validation.md, "Shell aortic leaflets": blood skimming the plane of a free edge within the half
 // spacing the sheet's patches reach beyond it). Returns the guard's put-backs and the particle's lowest
 // height.
-std::pair<long, double> skim_free_edge(double barrier) {
+// The square sheet at dx = 0.01 in the plane y = 0, no gravity, clamped for x below `held_to` (x = 1: all of
+// it), and room for one particle of water (material 0).
+Scene free_edge_scene(const std::string& name, double held_to, Body& sheet) {
   const double dx = 0.01;
-  Scene s = tank_scene("skim", dx, Vec3(0.1, 0.1, 0.1), 10.0, shell_sheet(1e6, 0.3, 0.2 * dx, 1000.0));
+  Scene s = tank_scene(name, dx, Vec3(0.1, 0.1, 0.1), 10.0, shell_sheet(1e6, 0.3, 0.2 * dx, 1000.0));
   s.gravity = Vec3::Zero();
   s.domain = {Vec3(-0.1, -0.1, -0.1), Vec3(0.2, 0.2, 0.2)};
-  s.contact.shell_fluid_barrier = barrier;
   s.max_density_error = 0.5;  // a lone particle: its summed density is low, which is not what this is about
-  Body sheet;
   sheet.name = "sheet";
   sheet.material = 2;
   sheet.shape.kind = ShapeKind::Rectangle;
@@ -435,7 +435,15 @@ std::pair<long, double> skim_free_edge(double barrier) {
   sheet.shape.size = {0.1, 0.1};
   sheet.shape.normal = Vec3::UnitY();
   sheet.shape.u_axis = Vec3::UnitX();
-  sheet.shell_fixed = {Box{Vec3(-1, -1, -1), Vec3(0.08, 1, 1)}};  // all but the last two rows
+  sheet.shell_fixed = {Box{Vec3(-1, -1, -1), Vec3(held_to, 1, 1)}};
+  return s;
+}
+
+std::pair<long, double> skim_free_edge(double barrier) {
+  const double dx = 0.01;
+  Body sheet;
+  Scene s = free_edge_scene("skim", 0.08, sheet);  // all but the last two rows held
+  s.contact.shell_fluid_barrier = barrier;
   const double y = 1e-5;  // the particle's height (lattice point at the box's min + dx / 2)
   s.bodies = {sheet, box_body("water", 0, Vec3(0.093, y - 0.5 * dx, 0.045), Vec3(0.103, y + 0.5 * dx, 0.055),
                               Vec3(0, -0.5, 0))};
@@ -547,19 +555,8 @@ TEST_CASE("shell-fluid: the barrier rounds a free edge's rim: water aimed at it 
   // barrier's K dx^2 d_c / 4 = 6e-3 J at the rim (half the kernel's patches there): it turns back 0.13 dx off
   // the rim (before the rim was rounded: 0.018 dx, and on over the sheet).
   const double dx = 0.01;
-  Scene s = tank_scene("rim", dx, Vec3(0.1, 0.1, 0.1), 10.0, shell_sheet(1e6, 0.3, 0.2 * dx, 1000.0));
-  s.gravity = Vec3::Zero();
-  s.domain = {Vec3(-0.1, -0.1, -0.1), Vec3(0.2, 0.2, 0.2)};
-  s.max_density_error = 0.5;  // a lone particle (as in skim_free_edge)
   Body sheet;
-  sheet.name = "sheet";
-  sheet.material = 2;
-  sheet.shape.kind = ShapeKind::Rectangle;
-  sheet.shape.center = Vec3(0.05, 0.0, 0.05);
-  sheet.shape.size = {0.1, 0.1};
-  sheet.shape.normal = Vec3::UnitY();
-  sheet.shape.u_axis = Vec3::UnitX();
-  sheet.shell_fixed = {Box{Vec3(-1, -1, -1), Vec3(1, 1, 1)}};  // held: the rim stays at x = 0.1
+  Scene s = free_edge_scene("rim", 1.0, sheet);                // held: the rim stays at x = 0.1
   const double rim = 0.1, x0 = rim + 0.3 * dx, y0 = 0.3 * dx;  // lattice point at the box's min + dx / 2
   s.bodies = {sheet, box_body("water", 0, Vec3(x0 - 0.5 * dx, y0 - 0.5 * dx, 0.045),
                               Vec3(x0 + 0.5 * dx, y0 + 0.5 * dx, 0.055), Vec3(-2.0, -2.0, 0))};
