@@ -96,6 +96,22 @@ inline Body box_body(const std::string& name, int material, Vec3 lo, Vec3 hi, Ve
   return b;
 }
 
+// A cylindrical shell panel of radius R whose crown is at the origin facing +z (its axis through (0, 0, -R)).
+inline Body cylindrical_panel(const std::string& name, int material, double R, Vec3 axis, double length,
+                              double angle_deg) {
+  Body b;
+  b.name = name;
+  b.material = material;
+  b.shape.kind = ShapeKind::CylindricalPanel;
+  b.shape.center = Vec3(0, 0, -R);
+  b.shape.axis = axis;
+  b.shape.radius = R;
+  b.shape.length = length;
+  b.shape.angle = angle_deg;
+  b.shape.normal = Vec3::UnitZ();
+  return b;
+}
+
 inline Body container(const std::string& name, int material, Vec3 lo, Vec3 hi,
                       std::vector<std::string> open) {
   Body b;

@@ -812,17 +812,7 @@ TEST_CASE("shell validation: Scordelis-Lo roof, mid free-edge vertical displacem
   m.shell_damping = std::getenv("ROOF_DAMPING") ? std::atof(std::getenv("ROOF_DAMPING")) : 12.0;
   if (std::getenv("ROOF_HG")) m.hourglass = std::atof(std::getenv("ROOF_HG"));  // diagnostic
   s.materials = {m};
-  Body b;
-  b.name = "roof";
-  b.material = 0;
-  b.shape.kind = ShapeKind::CylindricalPanel;
-  b.shape.center = Vec3(0, 0, -R);
-  b.shape.axis = Vec3::UnitX();
-  b.shape.radius = R;
-  b.shape.length = Lr + dx;
-  b.shape.angle = 80;
-  b.shape.normal = Vec3::UnitZ();
-  s.bodies = {b};
+  s.bodies = {cylindrical_panel("roof", 0, R, Vec3::UnitX(), Lr + dx, 80)};
   World w(s);
   Shells& sh = w.shells_for_test();
   for (std::size_t k = 0; k < sh.size(); ++k)

@@ -299,8 +299,7 @@ TEST_CASE(
 
 TEST_CASE(
     "shell contact: a wall particle in the tangent plane of a far particle of a curved sheet meets the "
-    "sheet's "
-    "own gap, on either side of that plane",
+    "sheet's own gap, on either side of that plane",
     "[shell_contact]") {
   // A cylindrical panel (R = 5 mm, 60 degrees, crown at z = 0 facing +z) and one wall particle in the crown
   // particle's tangent plane, 1.8 mm from it (inside the contact's 2 dx reach; its foot within dx / sqrt(2)
@@ -312,17 +311,9 @@ TEST_CASE(
   const double R = 5e-3;
   Scene s = base_scene();
   s.materials = {sheet_material(0.0), wall()};
-  Body b;
-  b.name = "panel";
-  b.material = 0;
-  b.shape.kind = ShapeKind::CylindricalPanel;
-  b.shape.center = Vec3(0, 0, -R);
-  b.shape.axis = Vec3::UnitY();
-  b.shape.radius = R;
-  b.shape.length = 7 * kDx;  // rows at y = -3 .. 3 mm: the crown particle (0, 0, 0) is not near an edge
-  b.shape.angle = 60;
-  b.shape.normal = Vec3::UnitZ();
-  s.bodies = {b, box_body("post", 1, Vec3(1.3e-3, -0.5e-3, 1e-3), Vec3(2.3e-3, 0.5e-3, 2e-3))};
+  // Rows at y = -3 .. 3 mm: the crown particle (0, 0, 0) is not near an edge.
+  s.bodies = {cylindrical_panel("panel", 0, R, Vec3::UnitY(), 7 * kDx, 60),
+              box_body("post", 1, Vec3(1.3e-3, -0.5e-3, 1e-3), Vec3(2.3e-3, 0.5e-3, 2e-3))};
   // (Built 1.5 mm above the sheet, within the lists' reach of where it is put below.)
   World w(s);
   const ShellContact contact({kK, -1.0, 0.5, kDx}, w.kernel().support);

@@ -105,7 +105,7 @@ ShellContact::Pair ShellContact::pair(const Particles& P, const Shells& sh, std:
     // stiffness without bound and a step of 1e-8 s.
     if (!(a_shell && b_shell) && !sh.over_sheet(ps, dp - sn * n, std::sqrt(0.5) * dx)) return Vec3::Zero();
     const double w = weight * area_a * area_b * cubic_spline_2d(rho, dx);
-    const Vec3 e = sn >= 0.0 ? n : Vec3(-n);  // from q's plane towards o
+    const Vec3 e = sn >= 0.0 ? n : Vec3(-n);  // from the plane (q's or the patch's) towards o
     const double rate = v.dot(e);             // d(gap)/dt
     out.near = true;
     // The pair's gap and closing time are those of the plane that carries at least half of it (both for
