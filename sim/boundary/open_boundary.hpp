@@ -184,6 +184,8 @@ class OpenBoundaries {
     double profile_mean = 1.0;                // inflow: mean of 1 - r^2 / R^2 over the columns
     int material = 0;                         // material of the fed body (outflow: the first fluid's)
     std::vector<Vec3> columns;                // inflow: lattice points of the columns on the disc
+    int column_nr = 0;                        // inflow: the lattice's half-width in columns
+    std::vector<int32_t> column_index;        // inflow: (j + nr) 2 nr + (i + nr) -> index in columns, or -1
     // Coordinates of x relative to the disc: along the normal, and distance from the axis.
     double axial(const Vec3& x) const { return (x - spec.point).dot(spec.normal); }
     double radial(const Vec3& x) const {
@@ -202,6 +204,11 @@ class OpenBoundaries {
     return z.depth >= list_reach_ + (velocity_inlet ? 1.1 : 0.1) * dx_;
   }
 
+  // Inflow zone z's lattice column that holds x (its lateral position), or -1.
+  int column_of(const Zone& z, const Vec3& x) const;
+  // Pressure inlet k: tops up every column of its buffer to `layers` particles (see the .cpp).
+  void refill_columns(Particles& P, std::size_t k, std::size_t n, const std::vector<uint8_t>& action,
+                      std::size_t& created, bool& rebuild);
   // Index of the zone whose buffer holds particle x of the given kind, or -1.
   int zone_of(const Vec3& x, Kind kind) const;
   // Pressure and density of every buffer particle at time t (records each boundary's pressure in flows_).
