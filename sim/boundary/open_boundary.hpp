@@ -32,10 +32,10 @@
 //     as a velocity inlet's; its particles take the prescribed p(t) plus the hydrostatic difference (density
 //     from the equation of state, mass rho dx^3 as a velocity inlet's), and their velocity is carried from
 //     the fluid next to the disc through the buffer (normal component, layer by layer, nearest the disc
-//     first, as at an outflow). A buffer particle that crosses the disc becomes fluid and a new one is
-//     created `layers` spacings behind it where the buffer has room; fluid that crosses the disc backwards
-//     (diastolic backflow) becomes a buffer particle (counted as volume out) and is removed when it passes
-//     the buffer's far face.
+//     first, as at an outflow). A buffer particle that crosses the disc becomes fluid; fluid that crosses
+//     the disc backwards (diastolic backflow) becomes a buffer particle (counted as volume out) and is
+//     removed when it passes the buffer's far face. Every lattice column is topped up to `layers` particles
+//     after each step (refill_columns in the .cpp).
 //   - Windkessel outlet (an outflow given `windkessel`): the outlet's p(t) is the RCR model's
 //     (sim/physiology/windkessel.hpp), advanced every step with the flow Q out of the domain at that step.
 //   - Flow through each boundary (for the Windkessel and the `open_boundary` probe), positive in the
