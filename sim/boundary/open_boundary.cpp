@@ -559,7 +559,9 @@ OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb
         if (z.spec.pressure_inlet) {
           // Backflow through a pressure inlet: the fluid joins the buffer at once (as at an outlet), in the
           // column its lateral position falls in (refill_columns counts it there).
-          if (z.axial(P.x[i]) < 0.0 && z.radial(P.x[i]) <= z.spec.radius) {
+          // Out to the wall's first layer (half a spacing beyond the disc's radius): fluid by the wall must
+          // not run down between the buffer's outer columns and the wall.
+          if (z.axial(P.x[i]) < 0.0 && z.radial(P.x[i]) <= z.spec.radius + 0.5 * dx_) {
             action[i] = kFluidToInflow;
             zone[i] = m;
           }
