@@ -323,6 +323,20 @@ Rows run(const Scene& s, double t_end, const std::function<void(const World&)>& 
   return r;
 }
 
+// The open_boundary probe `bal` of a run: mass in - mass out = the change of the mass inside, up to
+// round-off.
+void check_mass_balance(const Rows& r) {
+  const auto& a = r.rows.front();
+  const auto& b = r.rows.back();
+  auto col = [&](const std::string& name) {
+    return std::find(r.columns.begin(), r.columns.end(), name) - r.columns.begin() + 1;
+  };
+  const double m_in = b[col("bal.mass_in")] - a[col("bal.mass_in")];
+  const double m_out = b[col("bal.mass_out")] - a[col("bal.mass_out")];
+  const double m_change = b[col("bal.mass_inside")] - a[col("bal.mass_inside")];
+  CHECK(std::abs(m_in - m_out - m_change) < 1e-12 * b[col("bal.mass_inside")]);
+}
+
 }  // namespace
 
 TEST_CASE("pressure inlet: a pressure drop drives Poiseuille flow through a tube, and backflow",
@@ -370,16 +384,7 @@ TEST_CASE("pressure inlet: a pressure drop drives Poiseuille flow through a tube
     CHECK(inflow < 1.2 * t.layers * columns);
     CHECK(outflow > 0.8 * t.layers * columns);
     CHECK(outflow < 1.2 * t.layers * columns);
-    // Mass balance: exact up to round-off.
-    const auto& a = r.rows.front();
-    const auto& b = r.rows.back();
-    auto col = [&](const std::string& name) {
-      return std::find(r.columns.begin(), r.columns.end(), name) - r.columns.begin() + 1;
-    };
-    const double m_in = b[col("bal.mass_in")] - a[col("bal.mass_in")];
-    const double m_out = b[col("bal.mass_out")] - a[col("bal.mass_out")];
-    const double m_change = b[col("bal.mass_inside")] - a[col("bal.mass_inside")];
-    CHECK(std::abs(m_in - m_out - m_change) < 1e-12 * b[col("bal.mass_inside")]);
+    check_mass_balance(r);
   }
 }
 
@@ -432,15 +437,7 @@ TEST_CASE("pressure inlet: a flow reversing at 50 Hz keeps every buffer column f
   CHECK(fewest >= t.layers);
   CHECK(total <= 1.05 * t.layers * 52);
   CHECK(std::abs(static_cast<double>(fluid_end) / fluid_start - 1.0) < 0.05);
-  const auto& a = r.rows.front();
-  const auto& b = r.rows.back();
-  auto col = [&](const std::string& name) {
-    return std::find(r.columns.begin(), r.columns.end(), name) - r.columns.begin() + 1;
-  };
-  const double m_in = b[col("bal.mass_in")] - a[col("bal.mass_in")];
-  const double m_out = b[col("bal.mass_out")] - a[col("bal.mass_out")];
-  const double m_change = b[col("bal.mass_inside")] - a[col("bal.mass_inside")];
-  CHECK(std::abs(m_in - m_out - m_change) < 1e-12 * b[col("bal.mass_inside")]);
+  check_mass_balance(r);
 }
 
 TEST_CASE("windkessel outlet: the outlet pressure follows the RCR ODE driven by the measured flow",
