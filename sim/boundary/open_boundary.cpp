@@ -324,6 +324,28 @@ void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) {
   });
 }
 
+std::size_t OpenBoundaries::append_buffer_particle(Particles& P, const Vec3& x, Kind kind,
+                                                   std::optional<std::size_t> src) {
+  if (state_.next_id == std::numeric_limits<uint32_t>::max())
+    throw InstabilityError("open boundaries: particle ids exhausted");
+  const std::size_t j = P.size();
+  P.resize(j + 1);  // new entries are zero
+  P.x[j] = x;
+  P.x0[j] = x;
+  P.kind[j] = kind;
+  if (src) {
+    P.v[j] = P.v[*src];
+    P.v_wall[j] = P.v[*src];
+    P.rho[j] = P.rho[*src];
+    P.p[j] = P.p[*src];
+    P.m[j] = P.m[*src];
+    P.body[j] = P.body[*src];
+    P.material[j] = P.material[*src];
+  }
+  P.id[j] = state_.next_id++;
+  return j;
+}
+
 // A pressure inlet's buffer, column by column (Zone::columns): every lattice column holds `layers`
 // particles. Its particles move along the column with the velocity carried from the fluid (update), so a
 // column stays on its lattice line; where it holds fewer (its front particle became fluid, or in backflow its
@@ -343,14 +365,22 @@ void OpenBoundaries::refill_columns(Particles& P, std::size_t k, std::size_t n,
                                     const std::vector<uint8_t>& action, std::size_t& created, bool& rebuild) {
   const Zone& z = zones_[k];
   const std::size_t nc = z.columns.size();
-  // Each column's particles (axial position, index), front (nearest the disc) first.
-  std::vector<std::vector<std::pair<double, uint32_t>>> col(nc);
+  // The buffer's particles by column, each column front (nearest the disc) first.
+  struct Member {
+    int c;
+    double a;
+    uint32_t i;
+  };
+  std::vector<Member> members;
   for (std::size_t i = 0; i < n; ++i) {
     if (P.kind[i] != Kind::Inflow || (action[i] != kNone && action[i] != kFluidToInflow) || departed(P, i))
       continue;
     if (const int c = column_of(z, P.x[i]); c >= 0)
-      col[c].push_back({z.axial(P.x[i]), static_cast<uint32_t>(i)});
+      members.push_back({c, z.axial(P.x[i]), static_cast<uint32_t>(i)});
   }
+  std::sort(members.begin(), members.end(), [](const Member& p, const Member& q) {
+    return p.c < q.c || (p.c == q.c && (p.a > q.a || (p.a == q.a && p.i < q.i)));
+  });
   // The fluid next to the disc, for the room test of a particle added at a column's front.
   std::vector<Vec3> near_disc;
   bool near_disc_ready = false;
@@ -366,11 +396,12 @@ void OpenBoundaries::refill_columns(Particles& P, std::size_t k, std::size_t n,
       if ((q - x).squaredNorm() < kFrontRoom * kFrontRoom * dx_ * dx_) return false;
     return true;
   };
+  std::vector<std::pair<double, uint32_t>> list;  // one column's (axial position, index)
+  std::size_t next = 0;
   for (std::size_t c = 0; c < nc; ++c) {
-    auto& list = col[c];
-    std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) {
-      return a.first > b.first || (a.first == b.first && a.second < b.second);
-    });
+    list.clear();
+    for (; next < members.size() && members[next].c == static_cast<int>(c); ++next)
+      list.push_back({members[next].a, members[next].i});
     while (static_cast<int>(list.size()) < z.spec.layers) {
       // Where the new particle goes (axial position) and whose state it copies (an index in list).
       double a = 0.0;
@@ -390,24 +421,16 @@ void OpenBoundaries::refill_columns(Particles& P, std::size_t k, std::size_t n,
         }
       }
       if (!found) break;
-      if (state_.next_id == std::numeric_limits<uint32_t>::max())
-        throw InstabilityError("open boundaries: particle ids exhausted");
-      const std::size_t j = P.size();
-      P.resize(j + 1);
-      P.x[j] = z.columns[c] + a * z.spec.normal;
-      P.x0[j] = P.x[j];
-      P.kind[j] = Kind::Inflow;
-      const FluidParams& fp = fluid_[z.material];
-      const bool copy = !list.empty();
-      const uint32_t src = copy ? list[from].second : 0;
-      P.v[j] = copy ? P.v[src] : Vec3(Vec3::Zero());
-      P.v_wall[j] = P.v[j];
-      P.rho[j] = copy ? P.rho[src] : fp.rho0;
-      P.p[j] = copy ? P.p[src] : fp.p_background;
+      const Vec3 x = z.columns[c] + a * z.spec.normal;
+      const std::optional<std::size_t> src = list.empty() ? std::nullopt : std::optional(list[from].second);
+      const std::size_t j = append_buffer_particle(P, x, Kind::Inflow, src);
+      if (!src) {  // an empty column: at rest, at the background pressure
+        P.rho[j] = fluid_[z.material].rho0;
+        P.p[j] = fluid_[z.material].p_background;
+      }
       P.m[j] = P.rho[j] * dx_ * dx_ * dx_;  // impose() sets density, pressure and mass for the step
       P.body[j] = static_cast<uint16_t>(z.spec.body);
       P.material[j] = static_cast<uint16_t>(z.material);
-      P.id[j] = state_.next_id++;
       ++created;
       // Far-face particles of a deep buffer wait for the next list build; any other is within the fluid's
       // reach.
@@ -603,8 +626,6 @@ OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb
         state_.mass_in += P.m[i];
         const int k = zone[i];
         if (k < 0) break;
-        if (state_.next_id == std::numeric_limits<uint32_t>::max())
-          throw InstabilityError("open boundaries: particle ids exhausted");
         // The new buffer particle, `layers` spacings behind along the flow: behind the inlet disc, or at the
         // outlet buffer's far face when fluid flows back in through an outlet (the buffer stays full; without
         // this, every back-and-forth swing would lose the particles that passed the far face).
@@ -616,19 +637,7 @@ OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb
           if (!has_room(k, x_new)) break;
           resident[k].push_back(x_new);
         }
-        const std::size_t j = P.size();
-        P.resize(j + 1);
-        P.x[j] = x_new;
-        P.x0[j] = P.x[j];
-        P.kind[j] = inflow ? Kind::Inflow : Kind::Outflow;
-        P.v[j] = P.v[i];
-        P.v_wall[j] = P.v[i];
-        P.rho[j] = P.rho[i];
-        P.p[j] = P.p[i];
-        P.m[j] = P.m[i];
-        P.body[j] = P.body[i];
-        P.material[j] = P.material[i];
-        P.id[j] = state_.next_id++;
+        append_buffer_particle(P, x_new, inflow ? Kind::Inflow : Kind::Outflow, i);
         ++created;
         if (!defers(z)) rebuild = true;
         break;

@@ -69,6 +69,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "core/kernel.hpp"
@@ -204,6 +205,9 @@ class OpenBoundaries {
     return z.depth >= list_reach_ + (velocity_inlet ? 1.1 : 0.1) * dx_;
   }
 
+  // A new buffer particle of the given kind at x (a new id), with the state (velocity, density, pressure,
+  // mass, body, material) of particle src if given, else zero. Returns its index.
+  std::size_t append_buffer_particle(Particles& P, const Vec3& x, Kind kind, std::optional<std::size_t> src);
   // Inflow zone z's lattice column that holds x (its lateral position), or -1.
   int column_of(const Zone& z, const Vec3& x) const;
   // Pressure inlet k: tops up every column of its buffer to `layers` particles (see the .cpp).
