@@ -799,3 +799,52 @@ TEST_CASE("scenes/aortic_valve_cycle_physio.json loads: the LV waveform inlet an
   const Material& blood = s.materials[s.bodies[lv.body].material];
   CHECK(16e3 / (blood.density * blood.sound_speed * blood.sound_speed) < 0.01);
 }
+
+TEST_CASE("pressure inlet: the buffer's columns keep clear of a wall that is not on their lattice",
+          "[physiology]") {
+  // The aortic root's wall is rings of particles half a spacing outside the lumen, not the lattice the
+  // inlet's columns are laid on: an inlet disc of the lumen's radius (13 mm, as the physio scene's) had a
+  // ring of columns 0.5 spacings from the wall's first layer, and with the left-ventricular pressure behind
+  // them their particles entered the wall above the disc (stop 40). A pressure inlet drops the columns within
+  // 0.9 spacings of a body particle across its axis; a velocity inlet (flow prescribed per column) keeps all.
+  auto lattice_columns = [](double radius, double dx) {
+    const int nr = static_cast<int>(std::ceil(radius / dx));
+    int n = 0;
+    for (int j = -nr; j < nr; ++j)
+      for (int i = -nr; i < nr; ++i) n += std::hypot((i + 0.5) * dx, (j + 0.5) * dx) < radius;
+    return n;
+  };
+  for (const char* file : {"aortic_valve_cycle_physio.json", "aortic_root.json"}) {
+    const Scene s = load_scene(std::string(AORTASPH_TEST_DIR) + "/../scenes/" + file,
+                               {"resolution.spacing=0.0015", "aortic_root.leaflet_layers=2"})
+                        .scene;
+    const double dx = s.spacing;
+    const OpenBoundarySpec& in = s.open_boundaries.at(0);
+    REQUIRE(in.type == OpenBoundaryType::Inflow);
+    const World w(s);
+    const Particles& P = w.particles();
+    double nearest = 1e300;  // lateral distance from a buffer particle to a wall particle beside the buffer
+    for (std::size_t i = 0; i < P.size(); ++i) {
+      if (P.kind[i] != Kind::Inflow) continue;
+      for (std::size_t k = 0; k < P.size(); ++k) {
+        // Wall particles beside the buffer (between its far face and the disc; the normal is +y).
+        const double a = P.x[k].y() - in.point.y();
+        if (P.kind[k] != Kind::Wall || a < -in.layers * dx || a > 0.0) continue;
+        nearest = std::min(nearest, std::hypot(P.x[k].x() - P.x[i].x(), P.x[k].z() - P.x[i].z()));
+      }
+    }
+    const int all = lattice_columns(in.radius, dx);
+    const std::size_t buffer = w.count(Kind::Inflow);
+    INFO(file << ": buffer " << buffer << " particles in " << in.layers << " layers, " << all
+              << " lattice columns within the radius; nearest wall particle across the axis " << nearest / dx
+              << " spacings");
+    if (in.pressure_inlet) {
+      CHECK(nearest >= 0.9 * dx);
+      CHECK(buffer < static_cast<std::size_t>(in.layers * all));  // the rim's columns went
+      CHECK(buffer > static_cast<std::size_t>(0.8 * in.layers * all));
+    } else {
+      CHECK(nearest < 0.9 * dx);  // the velocity inlet's rim columns stay, close to the rings
+      CHECK(buffer == static_cast<std::size_t>(in.layers * all));
+    }
+  }
+}

@@ -208,6 +208,8 @@ class OpenBoundaries {
   // A new buffer particle of the given kind at x (a new id), with the state (velocity, density, pressure,
   // mass, body, material) of particle src if given, else zero. Returns its index.
   std::size_t append_buffer_particle(Particles& P, const Vec3& x, Kind kind, std::optional<std::size_t> src);
+  // Drops the pressure inlets' columns that pass within kColumnClearance spacings of a body (see the .cpp).
+  void clear_columns(const Particles& P);
   // Inflow zone z's lattice column that holds x (its lateral position), or -1.
   int column_of(const Zone& z, const Vec3& x) const;
   // Pressure inlet k: tops up every column of its buffer to `layers` particles (see the .cpp).
