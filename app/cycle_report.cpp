@@ -141,7 +141,8 @@ void check_cycle_columns(const Scene& s, const std::vector<std::string>& columns
   }
 }
 
-std::vector<CycleMetrics> cycle_metrics_of(const Scene& s, const CsvTable& table) {
+std::vector<CycleMetrics> cycle_metrics_of(const Scene& s, const CsvTable& table,
+                                           const CsvTable* diagnostics) {
   if (!s.cycle) return {};
   const CycleSpec& c = *s.cycle;
   const int tcol = table.column("time");
@@ -208,6 +209,15 @@ std::vector<CycleMetrics> cycle_metrics_of(const Scene& s, const CsvTable& table
       for (std::size_t k = 0; k < p->bodies.size(); ++k)
         sig.wall_min_cusp.push_back(col(c.wall_distance + ".min_" + std::to_string(k)));
     }
+  if (diagnostics) {
+    const int dt = diagnostics->column("time"), de = diagnostics->column("max_density_error");
+    if (dt >= 0 && de >= 0 && !diagnostics->rows.empty()) {
+      std::vector<double> t, e;
+      for (const auto& r : diagnostics->rows)
+        if (t.empty() || r[dt] > t.back()) t.push_back(r[dt]), e.push_back(r[de]);
+      for (const double x : sig.t) sig.density_error.push_back(sample(t, e, x));
+    }
+  }
   CycleOptions o;
   o.period = c.period;
   o.start = c.start;

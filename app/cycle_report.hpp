@@ -27,8 +27,10 @@ std::vector<std::pair<std::string, std::string>> cycle_columns(const Scene& scen
 // Throws InputError naming the cycle block's key when a column it names is not among the probes' columns.
 void check_cycle_columns(const Scene& scene, const std::vector<std::string>& probe_columns);
 
-// The metrics of every complete cycle in the table (probes.csv with a `time` column).
-std::vector<CycleMetrics> cycle_metrics_of(const Scene& scene, const CsvTable& probes);
+// The metrics of every complete cycle in the table (probes.csv with a `time` column); the density error comes
+// from diagnostics (diagnostics.csv, its `max_density_error` read at the probes' times) when given.
+std::vector<CycleMetrics> cycle_metrics_of(const Scene& scene, const CsvTable& probes,
+                                           const CsvTable* diagnostics = nullptr);
 
 // The cycles.csv column names of the scene's cycle block (the per-pair, per-commissure and per-cusp columns
 // follow its probes), in cycles.csv order.

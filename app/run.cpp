@@ -364,10 +364,14 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   std::vector<CycleMetrics> cycles;
   std::size_t cycles_reported = 0;
   bool cycles_changed = false;  // run.json is rewritten after an output that completed a cycle
+  auto cycles_of_run = [&]() {
+    const CsvTable diagnostics = read_csv(dir / "diagnostics.csv");
+    return cycle_metrics_of(scene, read_csv(dir / "probes.csv"), &diagnostics);
+  };
   auto update_cycles = [&]() {
     if (!scene.cycle) return;
     cycles_changed = true;
-    cycles = cycle_metrics_of(scene, read_csv(dir / "probes.csv"));
+    cycles = cycles_of_run();
     write_cycles_csv(dir / "cycles.csv", cycles);
     for (; cycles_reported < cycles.size(); ++cycles_reported)
       std::printf("aortasph: %s\n", cycle_line(cycles[cycles_reported]).c_str());
@@ -378,7 +382,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     // The cycles completed before the checkpoint were reported by the interrupted run (probes.csv holds
     // their rows): measured again for run.json, not printed again.
     while (next_cycle_end <= world.time() + 1e-9 * scene.cycle->period) next_cycle_end += scene.cycle->period;
-    cycles = cycle_metrics_of(scene, read_csv(dir / "probes.csv"));
+    cycles = cycles_of_run();
     cycles_reported = cycles.size();
   }
 
@@ -388,12 +392,12 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     const auto values = probes.measure(world);
     row.insert(row.end(), values.begin(), values.end());
     probe_csv->row(row);
+    diag_csv->row(diagnostics_row(world));
     if (scene.cycle && world.time() >= next_cycle_end - 1e-9 * scene.cycle->period) {
       while (next_cycle_end <= world.time() + 1e-9 * scene.cycle->period)
         next_cycle_end += scene.cycle->period;
       update_cycles();
     }
-    diag_csv->row(diagnostics_row(world));
     // --vtk-every N: frames 0, N, 2N, ... and the last output (the end state, which a study's stress map
     // reads).
     if (vtk && (frame % o.vtk_every == 0 || world.time() >= scene.t_end - 1e-9 * scene.output_interval))

@@ -255,6 +255,15 @@ TEST_CASE("cycle block: a short pulsatile tube run writes cycles.csv, run.json m
     for (const auto& row : cycles.rows) CHECK(std::isfinite(row[k]));
   }
   CHECK(cycles.rows[0][cycles.column("stroke_volume_ml")] > 0.0);
+  // The largest density error per cycle, from diagnostics.csv (issue 17 item 3).
+  const CsvTable diag = read_csv(out / "diagnostics.csv");
+  double largest = 0.0;
+  for (const auto& row : diag.rows)
+    if (row[diag.column("time")] <= 0.06 + 1e-9)
+      largest = std::max(largest, row[diag.column("max_density_error")]);
+  REQUIRE(cycles.column("max_density_error_pct") >= 0);
+  CHECK(cycles.rows[0][cycles.column("max_density_error_pct")] == Approx(100.0 * largest));
+  CHECK(largest > 0.0);
   // No valve: the orifice metrics are empty, not zero.
   CHECK(std::isnan(cycles.rows[1][cycles.column("peak_goa_cm2")]));
   CHECK(std::isfinite(cycles.rows[1][cycles.column("sv_change_pct")]));
@@ -774,4 +783,70 @@ TEST_CASE("gap_area, wall_distance and per_body probes: bad input exits 2 naming
   std::string err;
   CHECK(run_cli("check " + tube_cycle_scene(dir, cycle).string(), err) == 2);
   CHECK(err.find("cycle.gap_area: probe 'q_mid' is not a gap_area probe") != std::string::npos);
+}
+
+TEST_CASE("valve metrics: acoustic noise of the LV pressure and the largest density error per cycle",
+          "[physiology]") {
+  // The noise: RMS about a 10 ms centred running mean. A ramp (which the running mean follows exactly) plus
+  // a 200 Hz sine of 200 Pa sampled every 0.5 ms: each window is 21 samples, two periods and one more sample
+  // of the sample's own phase, so the deviation is 20/21 of the sine: RMS 134.7 Pa.
+  std::vector<double> t, p;
+  for (int i = 0; i <= 200; ++i) {
+    t.push_back(i * 5e-4);
+    p.push_back(5000.0 + 2e4 * t.back() + 200.0 * std::sin(2 * kPi * 200.0 * t.back()));
+  }
+  const double rms = 200.0 / std::sqrt(2.0) * 20.0 / 21.0;
+  CHECK(running_mean_rms(t, p, 0.02, 0.08, 0.01, 0.001) == Approx(rms).epsilon(0.01));
+  // Only samples whose whole window lies in the signal count: over [0, 0.1] the same.
+  CHECK(running_mean_rms(t, p, 0.0, 0.1, 0.01, 0.001) == Approx(rms).epsilon(0.01));
+  // Samples 2 ms apart, or a gap of 2 ms within reach of the window: not measurable.
+  std::vector<double> t2, p2;
+  for (std::size_t i = 0; i < t.size(); i += 4) t2.push_back(t[i]), p2.push_back(p[i]);
+  CHECK(std::isnan(running_mean_rms(t2, p2, 0.02, 0.08, 0.01, 0.001)));
+  std::vector<double> tg = t, pg = p;
+  tg.erase(tg.begin() + 100, tg.begin() + 103);
+  pg.erase(pg.begin() + 100, pg.begin() + 103);
+  CHECK(std::isnan(running_mean_rms(tg, pg, 0.02, 0.08, 0.01, 0.001)));
+  CHECK(std::isfinite(running_mean_rms(tg, pg, 0.02, 0.04, 0.01, 0.001)));  // the gap is out of reach
+
+  // In a cycle: the noise over the forward flow (the synthetic cycle's 0-0.3 s), and the largest density
+  // error of the cycle (a 1.2 % bump at 0.5 s).
+  CycleOptions o;
+  o.period = 0.8;
+  CycleSignals s = synthetic({400e-6}, {80.0});
+  for (const double x : s.t)
+    s.density_error.push_back(0.004 + 0.008 * std::exp(-std::pow((x - 0.5) / 0.01, 2)));
+  const CycleMetrics quiet = all_cycle_metrics(s, o).at(0);
+  // Noise of +-300 Pa alternating sample by sample over 0.05-0.25 s: a window of 11 samples holds 5 of the
+  // sample's sign and 6 of the other, so the deviation is 300 (1 + 1/11) Pa.
+  int noisy_samples = 0, counted = 0;
+  for (std::size_t i = 0; i < s.t.size(); ++i) {
+    if (s.t[i] > 0.05 && s.t[i] < 0.25) s.lv_pressure[i] += (i % 2 ? 300.0 : -300.0), ++noisy_samples;
+    if (s.t[i] >= 0.005 - 1e-9 && s.t[i] <= 0.3 + 1e-9) ++counted;
+  }
+  const CycleMetrics noisy = all_cycle_metrics(s, o).at(0);
+  INFO("LV noise: quiet " << quiet.lv_noise_Pa << " Pa, with +-300 Pa over 0.05-0.25 s " << noisy.lv_noise_Pa
+                          << " Pa");
+  CHECK(quiet.max_density_error_pct == Approx(1.2).epsilon(1e-3));
+  // The quiet cycle's LV pressure is smooth but for the end of ejection (10 -> -80 mmHg from 0.3 s), which
+  // the last windows reach; the noise adds its mean square over its share of the counted samples (those from
+  // 5 ms, where a whole window starts, to the end of forward flow at 0.3 s).
+  CHECK(quiet.lv_noise_Pa < 50.0);
+  const double dev = 300.0 * 12.0 / 11.0;
+  const double expected = std::sqrt(quiet.lv_noise_Pa * quiet.lv_noise_Pa +
+                                    dev * dev * noisy_samples / static_cast<double>(counted));
+  CHECK(noisy.lv_noise_Pa == Approx(expected).epsilon(0.03));
+  // No density error column, or samples 2 ms apart: NaN (written empty).
+  CycleSignals coarse = synthetic({400e-6}, {80.0});
+  CycleSignals thin;
+  for (std::size_t i = 0; i < coarse.t.size(); i += 2) {
+    thin.t.push_back(coarse.t[i]);
+    thin.valve_flow.push_back(coarse.valve_flow[i]);
+    thin.lv_pressure.push_back(coarse.lv_pressure[i]);
+    thin.aortic_pressure.push_back(coarse.aortic_pressure[i]);
+  }
+  const CycleMetrics m2 = all_cycle_metrics(thin, o).at(0);
+  CHECK(std::isnan(m2.max_density_error_pct));
+  CHECK(std::isnan(m2.lv_noise_Pa));
+  CHECK(std::isfinite(m2.stroke_volume_ml));
 }

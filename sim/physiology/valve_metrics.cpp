@@ -115,6 +115,31 @@ bool has(const Vec& v) {
 
 }  // namespace
 
+double running_mean_rms(const Vec& t, const Vec& v, double a, double b, double window, double max_dt) {
+  if (t.size() < 3 || !(b > a)) return kNaN;
+  const double half = 0.5 * window, eps = 1e-9 * std::max(window, max_dt);
+  // The samples must be max_dt apart or closer wherever a window reaches.
+  for (std::size_t i = 0; i + 1 < t.size(); ++i)
+    if (t[i + 1] > a - half - eps && t[i] < b + half + eps && t[i + 1] - t[i] > max_dt * (1 + 1e-6) + eps)
+      return kNaN;
+  double sum2 = 0.0;
+  int n = 0;
+  std::size_t lo = 0, hi = 0;  // the window [lo, hi) of sample i
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (t[i] < a - eps || t[i] > b + eps || std::isnan(v[i])) continue;
+    if (t[i] - half < t.front() - eps || t[i] + half > t.back() + eps) continue;  // a whole window only
+    while (t[lo] < t[i] - half - eps) ++lo;
+    hi = std::max(hi, lo);
+    while (hi < t.size() && t[hi] <= t[i] + half + eps) ++hi;
+    double mean = 0.0;
+    for (std::size_t k = lo; k < hi; ++k) mean += v[k];
+    mean /= static_cast<double>(hi - lo);
+    sum2 += (v[i] - mean) * (v[i] - mean);
+    ++n;
+  }
+  return n >= 3 ? std::sqrt(sum2 / n) : kNaN;
+}
+
 double sample(const Vec& t, const Vec& v, double x) {
   if (t.empty()) return kNaN;
   if (x <= t.front()) return v.front();
@@ -344,6 +369,14 @@ CycleMetrics cycle_metrics(const CycleSignals& s, double t0, double t1, const Cy
   for (const Vec& w : s.wall_min_cusp)
     m.leaflet_wall_min_systole_mm_per.push_back(ejection ? min_in(t, w, sa, sb) * 1e3 : kNaN);
 
+  // The fluid's honesty (issue 17 item 3): the largest density error of the cycle, and the acoustic noise of
+  // the LV pressure during forward flow (RMS about its 10 ms centred running mean, from samples <= 1 ms
+  // apart).
+  m.max_density_error_pct = has(s.density_error) ? 100.0 * max_in(t, s.density_error, t0, t1) : kNaN;
+  m.lv_noise_Pa = has(s.lv_pressure) && ejection
+                      ? running_mean_rms(t, s.lv_pressure, tf0, tf1, kNoiseWindow, kNoiseMaxSpacing)
+                      : kNaN;
+
   m.sv_change_pct = m.edp_change_pct = kNaN;
   m.periodic = false;
   return m;
@@ -436,6 +469,8 @@ std::vector<std::pair<std::string, double>> metric_table(const CycleMetrics& m) 
   for (std::size_t c = 0; c < m.leaflet_wall_min_systole_mm_per.size(); ++c)
     r.emplace_back("leaflet_wall_min_systole_c" + std::to_string(c) + "_mm",
                    m.leaflet_wall_min_systole_mm_per[c]);
+  r.emplace_back("max_density_error_pct", m.max_density_error_pct);
+  r.emplace_back("lv_noise_Pa", m.lv_noise_Pa);
   r.emplace_back("sv_change_pct", m.sv_change_pct);
   r.emplace_back("edp_change_pct", m.edp_change_pct);
   r.emplace_back("periodic", m.cycle == 0 ? kNaN : (m.periodic ? 1.0 : 0.0));

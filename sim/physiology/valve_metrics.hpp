@@ -11,6 +11,9 @@
 namespace aortasph {
 
 inline constexpr double kPaPerMmHg = 133.322387415;  // 1 mmHg = 133.322387415 Pa (conventional)
+// The acoustic noise of a pressure (issue 17 item 3): RMS about a 10 ms centred running mean, from samples
+// at most 1 ms apart (scripts/acoustic_noise.py computes the same from probes.csv).
+inline constexpr double kNoiseWindow = 0.01, kNoiseMaxSpacing = 0.001;
 
 // The signals of one run (all sampled at `t`); an empty vector is a signal the scene does not measure.
 struct CycleSignals {
@@ -38,6 +41,8 @@ struct CycleSignals {
   // Leaflet-wall distance (a wall_distance probe) [m]: over all leaflets and per leaflet.
   std::vector<double> wall_min;
   std::vector<std::vector<double>> wall_min_cusp;
+  // The fluid's largest relative density error |rho / rho0 - 1| (diagnostics.csv's max_density_error) [-].
+  std::vector<double> density_error;
 };
 
 struct CycleOptions {
@@ -79,6 +84,9 @@ struct CycleMetrics {
   // Smallest leaflet-wall distance during forward flow [mm]: over all leaflets and per leaflet.
   double leaflet_wall_min_systole_mm = 0;
   std::vector<double> leaflet_wall_min_systole_mm_per;
+  // Largest density error in the cycle [%]; noise of the LV pressure during forward flow [Pa]: the RMS about
+  // its centred running mean over kNoiseWindow, NaN unless the samples are kNoiseMaxSpacing apart or closer.
+  double max_density_error_pct = 0, lv_noise_Pa = 0;
   // Periodic state, against the previous cycle (NaN for the first).
   double sv_change_pct = 0, edp_change_pct = 0;
   bool periodic = false;
@@ -102,6 +110,11 @@ std::vector<std::pair<std::string, double>> metric_table(const CycleMetrics& m);
 
 // Piecewise-linear helpers (exposed for the tests). Integral of v over [a, b].
 double integrate(const std::vector<double>& t, const std::vector<double>& v, double a, double b);
+// RMS of v about its centred running mean (the mean of the samples within +- window / 2 of each) over the
+// samples in [a, b] whose whole window lies within the signal; NaN where the samples within reach of [a, b]
+// are more than max_dt apart, or fewer than 3 count.
+double running_mean_rms(const std::vector<double>& t, const std::vector<double>& v, double a, double b,
+                        double window, double max_dt);
 // Value at time x (linear, held at the ends).
 double sample(const std::vector<double>& t, const std::vector<double>& v, double x);
 
