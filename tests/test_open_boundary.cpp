@@ -699,6 +699,17 @@ TEST_CASE("open boundaries: a buffer outside the domain or overlapping a body ex
          j["open_boundaries"][0]["radius"] = 0.005;  // wider than the tube: the buffer runs into its wall
        },
        "open_boundaries[0] 'inlet': the inflow buffer overlaps body 'tube'"},
+      {"overlap, pressure inlet",
+       [](json& j) {
+         // A pressure inlet leaves out its rim columns (the disc's outermost spacing) that come within 0.9
+         // spacings of a body, but no more: a disc two spacings wider than the tube still overlaps its wall.
+         json& in = j["open_boundaries"][0];
+         in.erase("velocity");
+         in.erase("profile");
+         in["pressure"] = 100.0;
+         in["radius"] = 0.006;
+       },
+       "open_boundaries[0] 'inlet': the inflow buffer overlaps body 'tube'"},
   };
   for (const Case& c : cases) {
     json j = tube_json();

@@ -247,17 +247,19 @@ void OpenBoundaries::setup(const Scene& scene, const std::vector<FluidParams>& f
   }
 }
 
-// A pressure inlet's columns keep clear of the bodies beside the buffer: a column whose axis passes within
-// kColumnClearance spacings of a body particle (a wall, elastic, rigid or shell particle beside the buffer,
-// between its far face and the disc) is dropped. The lattice columns fill the disc out to its radius,
-// which is right where the wall lies on the same lattice (a tube: wall particles at r >= R, 1 spacing or
-// more from the outermost column) but not where it does not: the aortic root's wall is rings of particles
-// half a spacing outside the lumen (the blood filling it keeps half a spacing inside), so an inlet of the
-// lumen's radius had a ring of columns 0.52-0.6 spacings from the wall. Its particles, pushed in by the
-// left-ventricular pressure, entered the wall's first layer above the disc from 0.033 s and passed it from
-// 0.052 s (stop 40, physio scene). Velocity inlets keep every column: their flow is prescribed per column,
-// and at the rim a Poiseuille profile moves them at a few per cent of the mean. Columns depend on the
-// particles at set-up only, so a restored world (built from its scene, then its checkpoint) has the same.
+// A pressure inlet's columns keep clear of the bodies beside the buffer: a column in the disc's outermost
+// spacing (r >= radius - dx) whose axis passes within kColumnClearance spacings of a body particle (a wall,
+// elastic, rigid or shell particle beside the buffer, between its far face and the disc) is dropped. (A
+// column farther in that meets a body is an error, as before: the buffer overlaps the body.) The lattice
+// columns fill the disc out to its radius, which is right where the wall lies on the same lattice (a tube:
+// wall particles at r >= R, 1 spacing or more from the outermost column) but not where it does not: the
+// aortic root's wall is rings of particles half a spacing outside the lumen (the blood filling it keeps half
+// a spacing inside), so an inlet of the lumen's radius had a ring of columns 0.52-0.6 spacings from the wall.
+// Its particles, pushed in by the left-ventricular pressure, entered the wall's first layer above the disc
+// from 0.033 s and passed it from 0.052 s (stop 40, physio scene). Velocity inlets keep every column: their
+// flow is prescribed per column, and at the rim a Poiseuille profile moves them at a few per cent of the
+// mean. Columns depend on the particles at set-up only, so a restored world (built from its scene, then its
+// checkpoint) has the same.
 void OpenBoundaries::clear_columns(const Particles& P) {
   const double dx = dx_, clear2 = kColumnClearance * kColumnClearance * dx * dx;
   for (std::size_t k = 0; k < zones_.size(); ++k) {
@@ -279,8 +281,10 @@ void OpenBoundaries::clear_columns(const Particles& P) {
     for (const Vec3& c : z.columns) {
       const Vec3 r = c - z.spec.point;
       const Eigen::Vector2d q(r.dot(z.u), r.dot(z.v));
-      if (std::any_of(bodies.begin(), bodies.end(),
-                      [&](const Eigen::Vector2d& b) { return (b - q).squaredNorm() < clear2; }))
+      // The rim only (the disc's outermost spacing): a body inside the disc is an overlap, refused below.
+      const bool rim = q.norm() >= z.spec.radius - dx;
+      if (rim && std::any_of(bodies.begin(), bodies.end(),
+                             [&](const Eigen::Vector2d& b) { return (b - q).squaredNorm() < clear2; }))
         continue;
       const int i = static_cast<int>(std::floor(q.x() / dx)), j = static_cast<int>(std::floor(q.y() / dx));
       z.column_index[static_cast<std::size_t>((j + nr) * 2 * nr + (i + nr))] =
