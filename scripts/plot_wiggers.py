@@ -123,6 +123,8 @@ def main(argv):
         ("aortic sys / dia", None, "mmHg"),
         ("stress diastole peak", "stress_diastole_peak_kPa", "kPa"),
         ("effective height", "effective_height_mm", "mm"),
+        ("max density error", "max_density_error_pct", "%"),
+        ("LV noise (ejection)", "lv_noise_Pa", "Pa"),
     ]
 
     def fmt(v):
