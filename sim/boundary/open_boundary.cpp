@@ -127,25 +127,16 @@ void OpenBoundaries::configure(const Scene& scene, const std::vector<FluidParams
       // Lattice columns across the disc, laid out like the tube's (shapes.cpp), so that an inlet at a tube's
       // base continues the tube's lattice.
       const int nr = static_cast<int>(std::ceil(s.radius / dx));
-      std::vector<Vec3>& columns = z.columns;
       z.column_nr = nr;
-      z.column_index.assign(static_cast<std::size_t>(4 * nr * nr), -1);
-      double sum_profile = 0.0;
       for (int j = -nr; j < nr; ++j)
         for (int i = -nr; i < nr; ++i) {
           const double a = (i + 0.5) * dx, b = (j + 0.5) * dx;
-          const double r = std::hypot(a, b);
-          if (r >= s.radius) continue;
-          z.column_index[static_cast<std::size_t>((j + nr) * 2 * nr + (i + nr))] =
-              static_cast<int32_t>(columns.size());
-          columns.push_back(s.point + a * z.u + b * z.v);
-          sum_profile += 1.0 - (r / s.radius) * (r / s.radius);
+          if (std::hypot(a, b) < s.radius) z.columns.push_back(s.point + a * z.u + b * z.v);
         }
-      if (columns.empty())
+      if (z.columns.empty())
         throw SetupError(where(k, s) + ": radius " + std::to_string(s.radius) +
                          " holds no particle column at spacing " + std::to_string(dx));
-      z.area = static_cast<double>(columns.size()) * dx * dx;
-      z.profile_mean = sum_profile / static_cast<double>(columns.size());
+      index_columns(z);
     }
     zones_.push_back(z);
   }
@@ -274,32 +265,37 @@ void OpenBoundaries::clear_columns(const Particles& P) {
       const Vec3 r = P.x[i] - z.spec.point;
       bodies.push_back(Eigen::Vector2d(r.dot(z.u), r.dot(z.v)));
     }
-    std::vector<Vec3> kept;
-    double sum_profile = 0.0;
-    std::fill(z.column_index.begin(), z.column_index.end(), -1);
-    const int nr = z.column_nr;
-    for (const Vec3& c : z.columns) {
+    std::erase_if(z.columns, [&](const Vec3& c) {
       const Vec3 r = c - z.spec.point;
       const Eigen::Vector2d q(r.dot(z.u), r.dot(z.v));
       // The rim only (the disc's outermost spacing): a body inside the disc is an overlap, refused below.
-      const bool rim = q.norm() >= z.spec.radius - dx;
-      if (rim && std::any_of(bodies.begin(), bodies.end(),
-                             [&](const Eigen::Vector2d& b) { return (b - q).squaredNorm() < clear2; }))
-        continue;
-      const int i = static_cast<int>(std::floor(q.x() / dx)), j = static_cast<int>(std::floor(q.y() / dx));
-      z.column_index[static_cast<std::size_t>((j + nr) * 2 * nr + (i + nr))] =
-          static_cast<int32_t>(kept.size());
-      kept.push_back(c);
-      const double rr = q.norm() / z.spec.radius;
-      sum_profile += 1.0 - rr * rr;
-    }
-    if (kept.empty())
+      return q.norm() >= z.spec.radius - dx &&
+             std::any_of(bodies.begin(), bodies.end(),
+                         [&](const Eigen::Vector2d& b) { return (b - q).squaredNorm() < clear2; });
+    });
+    if (z.columns.empty())
       throw SetupError(where(k, z.spec) + ": every particle column lies within " +
                        std::to_string(kColumnClearance) + " spacings of a body");
-    z.columns = std::move(kept);
-    z.area = static_cast<double>(z.columns.size()) * dx * dx;
-    z.profile_mean = sum_profile / static_cast<double>(z.columns.size());
+    index_columns(z);
   }
+}
+
+// Inflow zone z's lattice lookup (column_index), area and mean Poiseuille profile from its columns.
+void OpenBoundaries::index_columns(Zone& z) const {
+  const double dx = dx_;
+  const int nr = z.column_nr;
+  z.column_index.assign(static_cast<std::size_t>(4 * nr * nr), -1);
+  double sum_profile = 0.0;
+  for (std::size_t m = 0; m < z.columns.size(); ++m) {
+    const Vec3 r = z.columns[m] - z.spec.point;
+    const int i = static_cast<int>(std::floor(r.dot(z.u) / dx)),
+              j = static_cast<int>(std::floor(r.dot(z.v) / dx));
+    z.column_index[static_cast<std::size_t>((j + nr) * 2 * nr + (i + nr))] = static_cast<int32_t>(m);
+    const double rr = std::hypot((i + 0.5) * dx, (j + 0.5) * dx) / z.spec.radius;  // the lattice point's
+    sum_profile += 1.0 - rr * rr;
+  }
+  z.area = static_cast<double>(z.columns.size()) * dx * dx;
+  z.profile_mean = sum_profile / static_cast<double>(z.columns.size());
 }
 
 int OpenBoundaries::zone_of(const Vec3& x, Kind kind) const {

@@ -210,6 +210,8 @@ class OpenBoundaries {
   std::size_t append_buffer_particle(Particles& P, const Vec3& x, Kind kind, std::optional<std::size_t> src);
   // Drops the pressure inlets' columns that pass within kColumnClearance spacings of a body (see the .cpp).
   void clear_columns(const Particles& P);
+  // Inflow zone z's column_index, area and profile_mean from its columns (see the .cpp).
+  void index_columns(Zone& z) const;
   // Inflow zone z's lattice column that holds x (its lateral position), or -1.
   int column_of(const Zone& z, const Vec3& x) const;
   // Pressure inlet k: tops up every column of its buffer to `layers` particles (see the .cpp).
