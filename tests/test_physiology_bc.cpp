@@ -203,6 +203,7 @@ struct PTube {
   double nu = 1e-3;           // kinematic viscosity [m^2/s]: a slow, laminar, quickly developed flow
   double background = 100.0;  // [Pa]
   double initial_velocity = 0.0;
+  double shifting = 0.0;  // the blood's particle-shifting coefficient
   Waveform inlet{{}, {100.0}, 0.0, 0.0};
   std::optional<double> velocity;  // a velocity inlet instead
   double outlet = 100.0;
@@ -227,6 +228,7 @@ Scene ptube(const PTube& t) {
   blood.viscosity = t.nu;
   blood.sound_speed = t.c0;
   blood.background_pressure = t.background;
+  blood.shifting = t.shifting;
   Material wall;
   wall.name = "wall";
   wall.type = MaterialType::Wall;
@@ -438,6 +440,41 @@ TEST_CASE("pressure inlet: a flow reversing at 50 Hz keeps every buffer column f
   CHECK(total <= 1.05 * t.layers * 52);
   CHECK(std::abs(static_cast<double>(fluid_end) / fluid_start - 1.0) < 0.05);
   check_mass_balance(r);
+}
+
+TEST_CASE("pressure inlet: with particle shifting, flow between equal pressures does not speed up by itself",
+          "[physiology][long]") {
+  // The same pressure, 6 kPa, at both ends of a tube 16 mm across and 32 mm long (2 mm spacing), the blood
+  // moving at 0.5 m/s at the start: nothing drives the flow, so after the start-up (the column, at the 2 kPa
+  // background, fills up to 6 kPa in the first few ms) it can only slow down, and shifting the particles
+  // (A = 2) must not change that. Before stop 42 the shift's part normal to the tube wall pushed the
+  // near-wall particles into the wall at every step and the pressure pushed them back; the shifted flow sped
+  // up by itself: 92 -> 99 ml/s from 10-20 to 60-80 ms where the unshifted one slows, 93 -> 73 ml/s (in a
+  // 24 mm, 44 mm long tube at c0 = 40 m/s, 456 -> 835 ml/s in 80 ms). The shift now keeps only its part along
+  // a boundary next to one (fluid/shifting.hpp): 94 -> 72 ml/s.
+  PTube t;
+  t.dx = 2e-3;
+  t.radius_dx = 4;
+  t.length_dx = 16;
+  t.c0 = 20.0;
+  t.nu = 3.3e-6;
+  t.background = 2000.0;
+  t.initial_velocity = 0.5;
+  t.shifting = 2.0;
+  t.inlet = Waveform{{}, {6000.0}, 0.0, 0.0};
+  t.outlet = 6000.0;
+  t.output_interval = 0.001;
+  auto change = [&](double shifting) {
+    t.shifting = shifting;
+    const Rows r = run(ptube(t), 0.08);
+    const double early = r.mean("q_mid", 0.01, 0.02), late = r.mean("q_mid", 0.06, 0.08);
+    UNSCOPED_INFO("shifting " << shifting << ": mid-tube flow " << early * 1e6 << " ml/s over 10-20 ms, "
+                              << late * 1e6 << " ml/s over 60-80 ms");
+    return late / early;
+  };
+  const double plain = change(0.0), shifted = change(2.0);
+  CHECK(shifted < 1.0);
+  CHECK(std::abs(shifted - plain) < 0.05);
 }
 
 TEST_CASE("windkessel outlet: the outlet pressure follows the RCR ODE driven by the measured flow",

@@ -14,7 +14,7 @@ void add_shift_ghosts(ShiftSums& s, const Particles& P, const FluidContext& ctx,
   const double vg = sw.ghost_mass[j] / sw.ghost_rho;
   sw.for_each_ghost(xij, i, j, P.body[j], [&](const Vec3& rg) {
     const double rg2 = rg.squaredNorm();
-    if (rg2 < support2 && rg2 > 0.0) s.add(ctx.kernel, w_dx, rg, rg2, vg);
+    if (rg2 < support2 && rg2 > 0.0) s.add(ctx.kernel, w_dx, rg, rg2, vg, true);
   });
 }
 
@@ -25,6 +25,10 @@ Vec3 shift_from(const ShiftSums& s, double A, double h, double speed, double dt,
     const double g = s.grad_c.norm();
     if (g <= 0.0) return Vec3::Zero();
     const Vec3 n = -s.grad_c / g;
+    dr -= dr.dot(n) * n;
+  }
+  if (const double b = s.boundary.norm(); b > 0.0) {  // beside a boundary: along it only
+    const Vec3 n = s.boundary / b;
     dr -= dr.dot(n) * n;
   }
   const double cap = 0.1 * dx, len = dr.norm();
