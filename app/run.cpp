@@ -409,7 +409,8 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   RunRecord rec;
   rec.scene = loaded.resolved.dump();
   rec.hash = scene_hash(loaded.resolved);
-  rec.scene_file = o.scene.string();
+  // Absolute, so that `resume` finds the scene's files (waveforms) from any working directory.
+  rec.scene_file = std::filesystem::weakly_canonical(std::filesystem::absolute(o.scene)).string();
   rec.sets = o.sets;
   rec.no_render = o.no_render;
   rec.vtk = o.vtk;
@@ -445,7 +446,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     if (!message.empty()) j["message"] = message;
     j["threads"] = threads;
     j["scene"] = loaded.resolved;
-    j["scene_file"] = o.scene.string();
+    j["scene_file"] = rec.scene_file;
     j["sets"] = o.sets;
     if (o.checkpoint_every) j["checkpoint_every"] = *o.checkpoint_every;
     if (resume) j["resumed_at"] = {{"time", world.time()}, {"frame", first_frame}};

@@ -36,6 +36,7 @@ inline int run_cli(const std::string& args, std::string& err) {
   const std::string cmd = std::string(AORTASPH_BINARY) + " " + args + " > /dev/null 2> " + e.string();
   const int status = std::system(cmd.c_str());
   err = slurp(e);
+  std::filesystem::remove(e);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 

@@ -177,6 +177,7 @@ int run_cli(const std::string& args, std::string* err = nullptr) {
   const std::string cmd = std::string(AORTASPH_BINARY) + " " + args + " > /dev/null 2> " + e.string();
   const int status = std::system(cmd.c_str());
   if (err) *err = slurp(e);
+  fs::remove(e);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 

@@ -798,8 +798,14 @@ TEST_CASE(
   std::string err;
   REQUIRE(aortasph::test::run_cli("run " + scene.string() + " --quiet --no-render --out " + whole.string(),
                                   err) == 0);
-  const pid_t pid = spawn({"run", scene.string(), "--quiet", "--no-render", "--checkpoint-every", "0.002",
+  // The interrupted run names its scene relative to the folder it starts in, and is resumed from another:
+  // the scene file is recorded as an absolute path (until stop 42 the relative one was, and a resume from
+  // elsewhere found no waveform file).
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir);
+  const pid_t pid = spawn({"run", "scn/tube.json", "--quiet", "--no-render", "--checkpoint-every", "0.002",
                            "--out", part.string()});
+  fs::current_path(cwd);
   for (int k = 0; k < 3000 && !fs::exists(part / "checkpoint.bin"); ++k)
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   ::kill(pid, SIGINT);
@@ -807,9 +813,12 @@ TEST_CASE(
   INFO("interrupted run: exit " << code);
   CHECK((code == 130 || code == 0));
   if (code == 130) {
+    INFO(err);
     REQUIRE(aortasph::test::run_cli("resume " + part.string() + " --quiet", err) == 0);
     CHECK(aortasph::test::slurp(part / "run.json").find("resumed_at") != std::string::npos);
   }
+  const nlohmann::json run = nlohmann::json::parse(aortasph::test::slurp(part / "run.json"));
+  CHECK(fs::path(run["scene_file"].get<std::string>()) == fs::weakly_canonical(scene));
   const std::string probes = aortasph::test::slurp(part / "probes.csv");
   CHECK(std::count(probes.begin(), probes.end(), '\n') == 14);  // header, t = 0, 0.001, ..., 0.012
   CHECK(probes == aortasph::test::slurp(whole / "probes.csv"));
