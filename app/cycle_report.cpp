@@ -257,11 +257,17 @@ std::vector<std::string> cycle_metric_names(const Scene& s) {
   return names;
 }
 
-void write_cycles_csv(const fs::path& file, const std::vector<CycleMetrics>& cycles) {
+void write_cycles_csv(const fs::path& file, const std::vector<CycleMetrics>& cycles, const Scene& scene) {
   std::ofstream f(file, std::ios::trunc);
   if (!f) throw InputError(file.string() + ": cannot open for writing");
-  const auto header = metric_table(cycles.empty() ? CycleMetrics{} : cycles.front());
-  for (std::size_t k = 0; k < header.size(); ++k) f << (k ? "," : "") << header[k].first;
+  // Before the first cycle completes the header is already the scene's (its per-pair and per-cusp columns
+  // too), so that a reader of an unfinished run sees the columns it will get.
+  std::vector<std::string> header;
+  if (cycles.empty())
+    header = cycle_metric_names(scene);
+  else
+    for (const auto& [name, value] : metric_table(cycles.front())) header.push_back(name);
+  for (std::size_t k = 0; k < header.size(); ++k) f << (k ? "," : "") << header[k];
   f << '\n';
   for (const CycleMetrics& m : cycles) {
     const auto row = metric_table(m);

@@ -37,7 +37,8 @@ std::vector<CycleMetrics> cycle_metrics_of(const Scene& scene, const CsvTable& p
 std::vector<std::string> cycle_metric_names(const Scene& scene);
 
 // Writes cycles.csv (one row per cycle, empty cells where a metric is not measurable).
-void write_cycles_csv(const std::filesystem::path& file, const std::vector<CycleMetrics>& cycles);
+void write_cycles_csv(const std::filesystem::path& file, const std::vector<CycleMetrics>& cycles,
+                      const Scene& scene);
 
 // The run.json entry: the period, the cycles and the periodic-state test; the last cycle is the one the
 // metrics are taken from.

@@ -372,7 +372,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     if (!scene.cycle) return;
     cycles_changed = true;
     cycles = cycles_of_run();
-    write_cycles_csv(dir / "cycles.csv", cycles);
+    write_cycles_csv(dir / "cycles.csv", cycles, scene);
     for (; cycles_reported < cycles.size(); ++cycles_reported)
       std::printf("aortasph: %s\n", cycle_line(cycles[cycles_reported]).c_str());
     std::fflush(stdout);

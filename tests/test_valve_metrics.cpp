@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <sstream>
 
 #include "cli_helpers.hpp"
 #include "core/parallel.hpp"
@@ -849,4 +850,29 @@ TEST_CASE("valve metrics: acoustic noise of the LV pressure and the largest dens
   CHECK(std::isnan(m2.max_density_error_pct));
   CHECK(std::isnan(m2.lv_noise_Pa));
   CHECK(std::isfinite(m2.stroke_volume_ml));
+}
+
+TEST_CASE("cycles.csv: before the first cycle completes, the header already has the scene's columns",
+          "[physiology]") {
+  // The physio scene's probes give per-pair coaptation, per-commissure gap and per-cusp stress and
+  // wall-distance columns. Until stop 42 an unfinished run's cycles.csv had only the columns every scene has
+  // (its header came from an empty metrics record), and the rest appeared when the first cycle completed.
+  const fs::path file = fs::path(AORTASPH_TEST_DIR) / ".." / "scenes" / "aortic_valve_cycle_physio.json";
+  const Scene s = load_scene(file, {}).scene;
+  const fs::path out = scratch("cycles_header") / "cycles.csv";
+  write_cycles_csv(out, {}, s);
+  const std::string text = aortasph::test::slurp(out);
+  REQUIRE(std::count(text.begin(), text.end(), '\n') == 1);  // the header, no row
+  std::vector<std::string> header;
+  std::istringstream line(text.substr(0, text.find('\n')));
+  for (std::string cell; std::getline(line, cell, ',');) header.push_back(cell);
+  CHECK(header == cycle_metric_names(s));
+  for (const char* name : {"coaptation_height_0_1_mm", "coaptation_height_1_2_mm", "effective_height_c2_mm",
+                           "commissural_gap_area_c0_mm2", "leaflet_wall_min_systole_c1_mm",
+                           "stroke_volume_ml", "max_density_error_pct"}) {
+    INFO(name);
+    CHECK(std::find(header.begin(), header.end(), name) != header.end());
+  }
+  // Without a probe that names the pairs and cusps, only the common columns.
+  CHECK(header.size() > metric_table(CycleMetrics{}).size());
 }
