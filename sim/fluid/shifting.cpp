@@ -14,7 +14,7 @@ void add_shift_ghosts(ShiftSums& s, const Particles& P, const FluidContext& ctx,
   const double vg = sw.ghost_mass[j] / sw.ghost_rho;
   sw.for_each_ghost(xij, i, j, P.body[j], [&](const Vec3& rg) {
     const double rg2 = rg.squaredNorm();
-    if (rg2 < support2 && rg2 > 0.0) s.add(ctx.kernel, w_dx, rg, rg2, vg, true);
+    if (rg2 < support2 && rg2 > 0.0) s.add(ctx.kernel, w_dx, rg, rg2, vg, int32_t(P.body[j]));
   });
 }
 
@@ -27,10 +27,19 @@ Vec3 shift_from(const ShiftSums& s, double A, double h, double speed, double dt,
     const Vec3 n = -s.grad_c / g;
     dr -= dr.dot(n) * n;
   }
-  if (const double b = s.boundary.norm(); b > 0.0) {  // beside a boundary: along it only
-    const Vec3 n = s.boundary / b;
-    dr -= dr.dot(n) * n;
+  // Beside boundaries: along them only. The bodies' normals, orthonormalised (Gram-Schmidt; a normal within
+  // about 1 degree of the span of those before it adds nothing), and dr's parts along them removed.
+  std::array<Vec3, 3> basis;
+  int nb = 0;
+  for (int k = 0; k < s.boundaries && nb < 3; ++k) {
+    Vec3 n = s.boundary[k];
+    const double len0 = n.norm();
+    if (!(len0 > 0.0)) continue;
+    for (int m = 0; m < nb; ++m) n -= n.dot(basis[m]) * basis[m];
+    const double len = n.norm();
+    if (len > 0.02 * len0) basis[nb++] = n / len;
   }
+  for (int m = 0; m < nb; ++m) dr -= dr.dot(basis[m]) * basis[m];
   const double cap = 0.1 * dx, len = dr.norm();
   return len > cap ? Vec3(dr * (cap / len)) : dr;
 }

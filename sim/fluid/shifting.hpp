@@ -15,18 +15,23 @@
 // is under 2.5, only the part of dr tangent to the surface (normal -grad C / |grad C|) is kept, and under 1.5
 // (a splash) none (Lind et al. 2012 sec. 3.3 treat the surface the same way, with 2-D thresholds). Next to a
 // boundary (a wall, body or shell particle in the support) only the part of dr tangent to the boundary is
-// kept as well, the boundary's normal being the direction of its particles' share of sum_j V_j grad W. The
-// concentration next to a boundary is not the bulk's (a curved wall's rings are not on the fluid's lattice),
-// so the normal part pushed the near-wall particles steadily into the wall, the pressure pushed them back,
-// and the velocity that did so was a real one to the continuity and momentum equations: in a tube between two
-// equal imposed pressures the flow accelerated by itself, 456 -> 835 ml/s in 80 ms (the outflow buffer's push
-// on the fluid 6 % low), where without shifting it stays at 455 -> 430 (docs/validation.md, "Shifting beside
-// walls", stop 42). A shift is capped at 0.1 dx per step. The quantities carried by the particle (velocity,
-// density) are not Taylor-corrected for the shift (as in the Fickian WCSPH schemes of Skillen et al.); mass
-// and momentum are untouched, so they stay conserved exactly.
+// kept as well, each boundary body's normal being the direction of its particles' share of sum_j V_j grad W;
+// beside two bodies (a leaflet's attachment to the root's wall) only the part along both, the corner's line,
+// and beside three none. (With one normal for all the bodies together, the part left at such a corner pointed
+// into one of them: from 0.022 s of the physio scene single particles went 0.4-0.9 dx into the wall at the
+// three leaflet nadirs, stop 42.) The concentration next to a boundary is not the bulk's (a curved wall's
+// rings are not on the fluid's lattice), so the normal part pushed the near-wall particles steadily into the
+// wall, the pressure pushed them back, and the velocity that did so was a real one to the continuity and
+// momentum equations: in a tube between two equal imposed pressures the flow accelerated by itself, 456 ->
+// 835 ml/s in 80 ms (the outflow buffer's push on the fluid 6 % low), where without shifting it stays at 455
+// -> 430 (docs/validation.md, "Shifting beside walls", stop 42). A shift is capped at 0.1 dx per step. The
+// quantities carried by the particle (velocity, density) are not Taylor-corrected for the shift (as in the
+// Fickian WCSPH schemes of Skillen et al.); mass and momentum are untouched, so they stay conserved exactly.
 #pragma once
 
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "fluid/fluid_wcsph.hpp"
@@ -38,19 +43,36 @@ namespace aortasph {
 struct ShiftSums {
   Vec3 grad_c = Vec3::Zero();
   double div_r = 0.0;
-  // The boundary particles' share of sum_j V_j grad_i W_ij: it points from the particle towards the
-  // boundaries in its support, and is zero where there are none (shift_from's wall rule).
-  Vec3 boundary = Vec3::Zero();
+  // Each boundary body's share of sum_j V_j grad_i W_ij, body by body (shift_from's wall rule): it points
+  // from the particle towards that body. Up to kBodies bodies; the shares of any further ones are added to
+  // the last.
+  static constexpr int kBodies = 4;
+  std::array<Vec3, kBodies> boundary;
+  std::array<int32_t, kBodies> boundary_body;
+  int boundaries = 0;
   // Neighbour j at x_ij = x_i - x_j (|x_ij|^2 = r2, inside the support), volume V_j = m_j / rho_j;
-  // w_dx = W(dx); on_boundary: j is a wall, body or (imaginary) shell particle.
-  void add(const CubicSpline& K, double w_dx, const Vec3& xij, double r2, double vj, bool on_boundary) {
+  // w_dx = W(dx); body: j's body when j is a wall, body or (imaginary) shell particle, -1 for fluid.
+  void add(const CubicSpline& K, double w_dx, const Vec3& xij, double r2, double vj, int32_t body) {
     constexpr double R = 0.2;
     const double r = std::sqrt(r2);
     const Vec3 grad_w = (K.dWdr(r) / r) * xij;
     const double q = K.W(r) / w_dx;
     grad_c += (vj * (1.0 + R * q * q * q * q)) * grad_w;
     div_r -= vj * grad_w.dot(xij);
-    if (on_boundary) boundary += vj * grad_w;
+    if (body >= 0) add_boundary(body, vj * grad_w);
+  }
+  void add_boundary(int32_t body, const Vec3& g) {
+    for (int k = 0; k < boundaries; ++k)
+      if (boundary_body[k] == body) {
+        boundary[k] += g;
+        return;
+      }
+    if (boundaries < kBodies) {
+      boundary_body[boundaries] = body;
+      boundary[boundaries++] = g;
+    } else {
+      boundary[kBodies - 1] += g;
+    }
   }
 };
 // The shell branch of add_shift_neighbour, out of line: only scenes with a shell beside a fluid reach it.
@@ -66,7 +88,8 @@ inline void add_shift_neighbour(ShiftSums& s, const Particles& P, const FluidCon
   if (ctx.shell_wall && P.kind[j] == Kind::Shell) return add_shift_ghosts(s, P, ctx, w_dx, i, j, xij);
   const double r2 = xij.squaredNorm();
   const double support2 = ctx.kernel.support * ctx.kernel.support;
-  if (r2 < support2 && r2 > 0.0) s.add(ctx.kernel, w_dx, xij, r2, P.m[j] / P.rho[j], !fluid_like(P.kind[j]));
+  if (r2 < support2 && r2 > 0.0)
+    s.add(ctx.kernel, w_dx, xij, r2, P.m[j] / P.rho[j], fluid_like(P.kind[j]) ? -1 : int32_t(P.body[j]));
 }
 
 // The shift of a particle with coefficient A, speed |v|, for a step of dt (the surface rule and the cap).
