@@ -459,13 +459,13 @@ std::pair<long, double> skim_free_edge(double barrier) {
 
 }  // namespace
 
-TEST_CASE(
-    "particle shifting beside boundaries: along one body's surface, along a corner's line, none in three",
-    "[shell_fluid][fluid]") {
+TEST_CASE("particle shifting beside boundaries: never towards one, along a corner's line, none in three",
+          "[shell_fluid][fluid]") {
   // shift_from's wall rule on given sums: a concentration gradient pointing away from a floor (body 0, below
   // the particle) and a side wall (body 1, at -x), so that the unrestricted shift would go down and to the
-  // left, into both. (Stop 42: with one normal for all bodies together, the part left at a leaflet's
-  // attachment to the root's wall pointed into one of them.)
+  // left, into both. (Stop 42: first the shift's whole part normal to one summed normal was removed; at a
+  // leaflet's attachment to the root's wall the part left pointed into one of them, and the part away from a
+  // wall, which holds a particle that came too close off it, was lost too.)
   const double A = 2.0, h = 1.3e-3, speed = 1.0, dt = 1e-5, dx = 1e-3;
   ShiftSums s;
   s.div_r = 3.0;
@@ -473,31 +473,36 @@ TEST_CASE(
   const Vec3 free_shift = shift_from(s, A, h, speed, dt, dx);
   REQUIRE(free_shift.x() < 0.0);
   REQUIRE(free_shift.y() < 0.0);
-  // Beside the floor only: the shift keeps its x and z parts, loses its y part.
+  const double tiny = 1e-12 * free_shift.norm();
+  // Beside the floor only: the shift keeps its x and z parts, loses its y part (towards the floor).
   ShiftSums floor = s;
   floor.add_boundary(0, Vec3(0.0, -80.0, 0.0));  // the floor's share of sum V grad W points down, at it
   const Vec3 f = shift_from(floor, A, h, speed, dt, dx);
-  CHECK(std::abs(f.y()) < 1e-12 * free_shift.norm());
+  CHECK(std::abs(f.y()) < tiny);
   CHECK(f.x() == Approx(free_shift.x()));
   CHECK(f.z() == Approx(free_shift.z()));
+  // A shift away from the floor is kept whole.
+  ShiftSums up = floor;
+  up.grad_c = -s.grad_c;
+  CHECK((shift_from(up, A, h, speed, dt, dx) + free_shift).norm() < tiny);
   // In the corner of the floor and the wall, slightly tilted against each other: along the corner's line
   // only, nothing into either body.
   ShiftSums corner = floor;
   const Vec3 n_wall = Vec3(-1.0, 0.1, 0.0).normalized();
   corner.add_boundary(1, 60.0 * n_wall);
   const Vec3 c = shift_from(corner, A, h, speed, dt, dx);
-  CHECK(std::abs(c.y()) < 1e-12 * free_shift.norm());
-  CHECK(std::abs(c.dot(n_wall)) < 1e-12 * free_shift.norm());
+  CHECK(std::abs(c.y()) < tiny);
+  CHECK(std::abs(c.dot(n_wall)) < tiny);
   CHECK(c.z() == Approx(free_shift.z()));
-  // The two bodies' shares summed into one normal (the rule before): the shift left would enter one body.
-  ShiftSums merged = s;
-  merged.add_boundary(0, Vec3(0.0, -80.0, 0.0) + 60.0 * n_wall);
-  const Vec3 m = shift_from(merged, A, h, speed, dt, dx);
+  // The two bodies' shares summed into one normal and its whole normal part removed (the first rule): the
+  // shift left would enter one body.
+  const Vec3 both = (Vec3(0.0, -80.0, 0.0) + 60.0 * n_wall).normalized();
+  const Vec3 m = free_shift - free_shift.dot(both) * both;
   CHECK(std::max(-m.y(), m.dot(n_wall)) > 0.1 * free_shift.norm());
-  // A third body (a ceiling-like wall at +z): no shift at all.
+  // A third body the shift points at (at -z): no shift at all.
   ShiftSums three = corner;
-  three.add_boundary(2, Vec3(0.0, 0.0, 40.0));
-  CHECK(shift_from(three, A, h, speed, dt, dx).norm() < 1e-12 * free_shift.norm());
+  three.add_boundary(2, Vec3(0.0, 0.0, -40.0));
+  CHECK(shift_from(three, A, h, speed, dt, dx).norm() < tiny);
 }
 
 TEST_CASE("shell-fluid: water close to a curved sheet is on the sheet's side of it, not a tangent plane's",

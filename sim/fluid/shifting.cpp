@@ -14,7 +14,8 @@ void add_shift_ghosts(ShiftSums& s, const Particles& P, const FluidContext& ctx,
   const double vg = sw.ghost_mass[j] / sw.ghost_rho;
   sw.for_each_ghost(xij, i, j, P.body[j], [&](const Vec3& rg) {
     const double rg2 = rg.squaredNorm();
-    if (rg2 < support2 && rg2 > 0.0) s.add(ctx.kernel, w_dx, rg, rg2, vg, int32_t(P.body[j]));
+    // Not a boundary to the wall rule (shifting.hpp): the sheet's own coupling keeps the fluid off it.
+    if (rg2 < support2 && rg2 > 0.0) s.add(ctx.kernel, w_dx, rg, rg2, vg, -1);
   });
 }
 
@@ -27,19 +28,32 @@ Vec3 shift_from(const ShiftSums& s, double A, double h, double speed, double dt,
     const Vec3 n = -s.grad_c / g;
     dr -= dr.dot(n) * n;
   }
-  // Beside boundaries: along them only. The bodies' normals, orthonormalised (Gram-Schmidt; a normal within
-  // about 1 degree of the span of those before it adds nothing), and dr's parts along them removed.
-  std::array<Vec3, 3> basis;
-  int nb = 0;
-  for (int k = 0; k < s.boundaries && nb < 3; ++k) {
-    Vec3 n = s.boundary[k];
-    const double len0 = n.norm();
-    if (!(len0 > 0.0)) continue;
-    for (int m = 0; m < nb; ++m) n -= n.dot(basis[m]) * basis[m];
-    const double len = n.norm();
-    if (len > 0.02 * len0) basis[nb++] = n / len;
+  // Beside boundaries: never towards one. The bodies dr points towards (dr . n_k > 0, n_k the direction of
+  // body k's share of sum V grad W) are the active ones; dr loses its part along the span of their normals
+  // (orthonormalised by Gram-Schmidt; a normal within about 1 degree of the span of those before it adds
+  // nothing), and bodies the remainder points towards join the set, until none does. A part away from a body
+  // is kept: it is what holds a particle that came too close off the wall (the anti-clumping term of grad C).
+  const Vec3 dr0 = dr;
+  std::array<bool, ShiftSums::kBodies> active{};
+  for (int pass = 0; pass < ShiftSums::kBodies; ++pass) {
+    bool joined = false;
+    for (int k = 0; k < s.boundaries; ++k)
+      if (!active[k] && dr.dot(s.boundary[k]) > 1e-12 * dr.norm() * s.boundary[k].norm())
+        active[k] = joined = true;
+    if (!joined) break;
+    std::array<Vec3, 3> basis;
+    int nb = 0;
+    for (int k = 0; k < s.boundaries && nb < 3; ++k) {
+      if (!active[k]) continue;
+      Vec3 n = s.boundary[k];
+      const double len0 = n.norm();
+      for (int m = 0; m < nb; ++m) n -= n.dot(basis[m]) * basis[m];
+      const double len = n.norm();
+      if (len > 0.02 * len0) basis[nb++] = n / len;
+    }
+    dr = dr0;
+    for (int m = 0; m < nb; ++m) dr -= dr.dot(basis[m]) * basis[m];
   }
-  for (int m = 0; m < nb; ++m) dr -= dr.dot(basis[m]) * basis[m];
   const double cap = 0.1 * dx, len = dr.norm();
   return len > cap ? Vec3(dr * (cap / len)) : dr;
 }

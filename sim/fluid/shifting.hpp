@@ -14,19 +14,21 @@
 // particle's kernel divergence of position, div r_i = -sum_j V_j grad_i W_ij . x_ij (3 in the bulk in 3-D),
 // is under 2.5, only the part of dr tangent to the surface (normal -grad C / |grad C|) is kept, and under 1.5
 // (a splash) none (Lind et al. 2012 sec. 3.3 treat the surface the same way, with 2-D thresholds). Next to a
-// boundary (a wall, body or shell particle in the support) only the part of dr tangent to the boundary is
-// kept as well, each boundary body's normal being the direction of its particles' share of sum_j V_j grad W;
-// beside two bodies (a leaflet's attachment to the root's wall) only the part along both, the corner's line,
-// and beside three none. (With one normal for all the bodies together, the part left at such a corner pointed
-// into one of them: from 0.022 s of the physio scene single particles went 0.4-0.9 dx into the wall at the
-// three leaflet nadirs, stop 42.) The concentration next to a boundary is not the bulk's (a curved wall's
-// rings are not on the fluid's lattice), so the normal part pushed the near-wall particles steadily into the
-// wall, the pressure pushed them back, and the velocity that did so was a real one to the continuity and
-// momentum equations: in a tube between two equal imposed pressures the flow accelerated by itself, 456 ->
-// 835 ml/s in 80 ms (the outflow buffer's push on the fluid 6 % low), where without shifting it stays at 455
-// -> 430 (docs/validation.md, "Shifting beside walls", stop 42). A shift is capped at 0.1 dx per step. The
-// quantities carried by the particle (velocity, density) are not Taylor-corrected for the shift (as in the
-// Fickian WCSPH schemes of Skillen et al.); mass and momentum are untouched, so they stay conserved exactly.
+// boundary (a wall, rigid or elastic particle in the support; not a shell, whose two-sided coupling keeps the
+// fluid off it, fluid/shell_wall.hpp: with shells in this rule, single particles went 0.8 dx into the root's
+// wall at the leaflet nadirs by 0.03 s of the physio scene, stop 42) the shift never moves a particle towards
+// it: each boundary body's direction is that of its particles' share of sum_j V_j grad W, and dr loses its
+// part along those it points towards (beside two, a floor meeting a side wall, it keeps at most the part
+// along the corner's line), while a part away from a body is kept (the anti-clumping term of grad C pushes a
+// particle that came too close off the wall). The concentration next to a boundary is not the bulk's (a
+// curved wall's rings are not on the fluid's lattice), so the part towards it pushed the near-wall particles
+// steadily into the wall, the pressure pushed them back, and the velocity that did so was a real one to the
+// continuity and momentum equations: in a tube between two equal imposed pressures the flow accelerated by
+// itself, 456 -> 835 ml/s in 80 ms (the outflow buffer's push on the fluid 6 % low), where without shifting
+// it stays at 455 -> 430 (docs/validation.md, "Shifting beside walls", stop 42). A shift is capped at 0.1 dx
+// per step. The quantities carried by the particle (velocity, density) are not Taylor-corrected for the shift
+// (as in the Fickian WCSPH schemes of Skillen et al.); mass and momentum are untouched, so they stay
+// conserved exactly.
 #pragma once
 
 #include <array>
@@ -51,7 +53,7 @@ struct ShiftSums {
   std::array<int32_t, kBodies> boundary_body;
   int boundaries = 0;
   // Neighbour j at x_ij = x_i - x_j (|x_ij|^2 = r2, inside the support), volume V_j = m_j / rho_j;
-  // w_dx = W(dx); body: j's body when j is a wall, body or (imaginary) shell particle, -1 for fluid.
+  // w_dx = W(dx); body: j's body when j is a wall, rigid or elastic particle, -1 for fluid and shells.
   void add(const CubicSpline& K, double w_dx, const Vec3& xij, double r2, double vj, int32_t body) {
     constexpr double R = 0.2;
     const double r = std::sqrt(r2);
@@ -89,7 +91,8 @@ inline void add_shift_neighbour(ShiftSums& s, const Particles& P, const FluidCon
   const double r2 = xij.squaredNorm();
   const double support2 = ctx.kernel.support * ctx.kernel.support;
   if (r2 < support2 && r2 > 0.0)
-    s.add(ctx.kernel, w_dx, xij, r2, P.m[j] / P.rho[j], fluid_like(P.kind[j]) ? -1 : int32_t(P.body[j]));
+    s.add(ctx.kernel, w_dx, xij, r2, P.m[j] / P.rho[j],
+          fluid_like(P.kind[j]) || P.kind[j] == Kind::Shell ? -1 : int32_t(P.body[j]));
 }
 
 // The shift of a particle with coefficient A, speed |v|, for a step of dt (the surface rule and the cap).
