@@ -463,7 +463,6 @@ TEST_CASE("pressure inlet: with particle shifting, flow between equal pressures 
   t.nu = 3.3e-6;
   t.background = 2000.0;
   t.initial_velocity = 0.5;
-  t.shifting = 2.0;
   t.inlet = Waveform{{}, {6000.0}, 0.0, 0.0};
   t.outlet = 6000.0;
   t.output_interval = 0.001;
