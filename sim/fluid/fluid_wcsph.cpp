@@ -70,9 +70,11 @@ void fluid_pressure(Particles& P, const FluidContext& ctx) {
 void fluid_pair_terms(const Particles& P, FluidContext& ctx) {
   ctx.p_over_rho2.resize(P.size());
   ctx.volume.resize(P.size());
+  ctx.inv_rho.resize(P.size());
   parallel_for(P.size(), [&](std::size_t i) {
     ctx.p_over_rho2[i] = P.p[i] / (P.rho[i] * P.rho[i]);
     ctx.volume[i] = P.m[i] / P.rho[i];
+    ctx.inv_rho[i] = 1.0 / P.rho[i];
   });
 }
 
@@ -128,7 +130,7 @@ namespace {
 struct FluidI {
   std::size_t i;
   Vec3 x, v;
-  double rho, p, p_over_rho2;
+  double rho, p, p_over_rho2, inv_rho;
   const FluidParams* params;
   FluidI(const Particles& P, const FluidContext& ctx, std::size_t i)
       : i(i),
@@ -137,6 +139,7 @@ struct FluidI {
         rho(P.rho[i]),
         p(P.p[i]),
         p_over_rho2(ctx.p_over_rho2[i]),
+        inv_rho(ctx.inv_rho[i]),
         params(&ctx.params[P.material[i]]) {}
 };
 
@@ -223,16 +226,29 @@ inline Vec3 local_wall_term(const FluidContext& ctx, const PairConstants& c, con
   return -eps * tension * f2 * f2;
 }
 
+// Particle shifting's sums of fluid particle i (fluid/shifting.hpp), carried by its force loop.
+struct PairShift {
+  ShiftSums& sums;
+  double w_dx;  // W(dx)
+};
+
 // Inlined into the pair loops: out of line (GCC's choice once the shell and transport-velocity terms were
 // added) the force loop of the aortic bench took about 15 % longer (docs/performance.md, issue 18).
+// With `shift` (fluid_forces, where the material shifts), the pair's term of the shift's sums is added to
+// shift->sums from the same r and grad W: one square root and one kernel gradient per pair instead of two,
+// every sum bitwise what add_shift_neighbour gives (stop 43: the force phase of the physio scene 15 %
+// shorter).
 [[gnu::always_inline]] inline Vec3 pair_acceleration(const Particles& P, const FluidContext& ctx,
                                                      const PairConstants& c, const FluidI& I, std::size_t j,
-                                                     Vec3* background = nullptr) {
+                                                     Vec3* background = nullptr,
+                                                     const PairShift* shift = nullptr) {
   const Vec3 xij = ctx.separation(I.x, P.x[j]);
   const double r2 = xij.squaredNorm();
+  const bool shell_j = ctx.shell_wall && P.kind[j] == Kind::Shell;
+  if (shift && shell_j) add_shift_ghosts(shift->sums, P, ctx, shift->w_dx, I.i, j, xij);
   if (r2 >= c.support2 || r2 <= 0.0) return Vec3::Zero();  // Verlet-list pairs in the skin
   // The imaginary particles lie farther from i than j itself, so the early return above holds for them.
-  if (ctx.shell_wall && P.kind[j] == Kind::Shell) return shell_acceleration(P, ctx, c, I, j, xij, background);
+  if (shell_j) return shell_acceleration(P, ctx, c, I, j, xij, background);
   const FluidParams& fi = *I.params;
   const double h = c.h, eta2 = c.eta2;
   const double r = std::sqrt(r2);
@@ -242,6 +258,10 @@ inline Vec3 local_wall_term(const FluidContext& ctx, const PairConstants& c, con
   const double rhoi = I.rho;
   const double rhoj = P.rho[j];
   const bool fluid_j = fluid_like(P.kind[j]);  // open-boundary buffer particles count as fluid
+  // ctx.volume[j] is m_j / rho_j of this very step (fluid_pair_terms runs just before the forces).
+  if (shift)
+    shift->sums.add_gradient(xij, gradW, ctx.kernel.W(r) / shift->w_dx, ctx.volume[j],
+                             fluid_j ? -1 : int32_t(P.body[j]));
   const Vec3 vij = I.v - P.v[j];
 
   // Pressure, eq. (9) with the 1/rho_i of Algorithm 1 line 9 applied: a_i = -sum m_j (p_i/rho_i^2 +
@@ -290,7 +310,7 @@ inline Vec3 local_wall_term(const FluidContext& ctx, const PairConstants& c, con
   const double nu = fluid_j ? 0.5 * (fi.nu + ctx.params[P.material[j]].nu) : fi.nu;
   if (nu > 0.0 && (fluid_j || !ctx.free_slip_of(P.body[j]))) {
     const Vec3 vij_visc = fluid_j ? vij : Vec3(I.v - P.v_wall[j]);
-    const double f = nu * mj * (1.0 / rhoi + 1.0 / rhoj) * (r * dwdr) / (r2 + eta2);
+    const double f = nu * mj * (I.inv_rho + ctx.inv_rho[j]) * (r * dwdr) / (r2 + eta2);  // 1/rho_i + 1/rho_j
     acc += f * vij_visc;
   }
 
@@ -317,6 +337,7 @@ void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ct
     const double A = shift ? I.params->shifting : 0.0;
     Vec3 acc = Vec3::Zero();
     ShiftSums sums;
+    const PairShift pair_shift{sums, w_dx};
     // Particle shifting's sums over the same neighbours, in the same order (fluid/shifting.hpp).
     auto add_shift = [&](uint32_t j) {
       add_shift_neighbour(sums, P, ctx, w_dx, i, j, ctx.separation(I.x, P.x[j]));
@@ -326,10 +347,8 @@ void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ct
     // Two copies of the loop on purpose: with the shift's branch inside one loop the force phase of the
     // dam-break bench (no shifting) took 10-25 % longer (stop 31, alternated `bench --quick --threads 1`).
     if (A > 0.0) {
-      for (uint32_t k = nb.begin(i); k < local; ++k) {
-        acc += pair_acceleration(P, ctx, c, I, idx[k]);
-        add_shift(idx[k]);
-      }
+      for (uint32_t k = nb.begin(i); k < local; ++k)
+        acc += pair_acceleration(P, ctx, c, I, idx[k], nullptr, &pair_shift);
     } else {
       for (uint32_t k = nb.begin(i); k < local; ++k) acc += pair_acceleration(P, ctx, c, I, idx[k]);
     }

@@ -78,13 +78,15 @@ struct FluidContext {
   // zero where a material has it off; empty when no material has it on.
   std::vector<Vec3> transport_dv = {};
   double inv_w_dx = 0.0;  // 1 / W(particle spacing): the tensile correction's reference (World sets it)
+  // Per particle: 1 / rho, for the viscous term (one division per particle and step, not one per pair).
+  std::vector<double> inv_rho = {};
   // x_i - x_j, or its nearest image along periodic axes.
   Vec3 separation(const Vec3& xi, const Vec3& xj) const {
     return periodic.any ? periodic.image(xi - xj) : Vec3(xi - xj);
   }
 };
 
-// Fills ctx.p_over_rho2 and ctx.volume from the current p and rho.
+// Fills ctx.p_over_rho2, ctx.volume and ctx.inv_rho from the current p and rho.
 void fluid_pair_terms(const Particles& P, FluidContext& ctx);
 
 // Density by summation, eq. (11), for fluid particles whose material asks for it.

@@ -55,10 +55,13 @@ struct ShiftSums {
   // Neighbour j at x_ij = x_i - x_j (|x_ij|^2 = r2, inside the support), volume V_j = m_j / rho_j;
   // w_dx = W(dx); body: j's body when j is a wall, rigid or elastic particle, -1 for fluid and shells.
   void add(const CubicSpline& K, double w_dx, const Vec3& xij, double r2, double vj, int32_t body) {
-    constexpr double R = 0.2;
     const double r = std::sqrt(r2);
-    const Vec3 grad_w = (K.dWdr(r) / r) * xij;
-    const double q = K.W(r) / w_dx;
+    add_gradient(xij, (K.dWdr(r) / r) * xij, K.W(r) / w_dx, vj, body);
+  }
+  // The same with grad_i W_ij and q = W_ij / W(dx) already known (the force loop computes grad W for its
+  // own terms: fluid_forces).
+  void add_gradient(const Vec3& xij, const Vec3& grad_w, double q, double vj, int32_t body) {
+    constexpr double R = 0.2;
     grad_c += (vj * (1.0 + R * q * q * q * q)) * grad_w;
     div_r -= vj * grad_w.dot(xij);
     if (body >= 0) add_boundary(body, vj * grad_w);
