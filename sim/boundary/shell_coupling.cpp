@@ -119,6 +119,21 @@ void ShellCoupling::build_guard_surface(std::size_t n,
   for (std::size_t k = 0; k < tris_.size(); ++k)
     for (int m = 0; m < 3; ++m)
       if (first(tris_[k], m)) tri_of_[fill[tris_[k].slot[m]]++] = static_cast<uint32_t>(k);
+  // Each slot's candidates for closest_on_sheet, once (they were gathered and sorted at every call: 2 % of
+  // the physio scene's step, stop 43).
+  near_offset_.assign(n + 1, 0);
+  near_of_.clear();
+  std::vector<uint32_t> near;
+  for (std::size_t s = 0; s < n; ++s) {
+    near.clear();
+    for (uint32_t k = tri_offset_[s]; k < tri_offset_[s + 1]; ++k)
+      for (const uint32_t v : tris_[tri_of_[k]].slot)
+        near.insert(near.end(), tri_of_.begin() + tri_offset_[v], tri_of_.begin() + tri_offset_[v + 1]);
+    std::sort(near.begin(), near.end());
+    near.erase(std::unique(near.begin(), near.end()), near.end());
+    near_of_.insert(near_of_.end(), near.begin(), near.end());
+    near_offset_[s + 1] = static_cast<uint32_t>(near_of_.size());
+  }
 }
 
 void ShellCoupling::on_build(const Particles& P, NeighborSearch& nb) {
@@ -510,15 +525,9 @@ ShellCoupling::Closest ShellCoupling::closest_on_sheet(const Particles& P, const
   Closest out;
   if (tris_.empty()) return out;
   // The triangles touching s and those touching their vertices, each once, in ascending order.
-  thread_local std::vector<uint32_t> near;
-  near.clear();
-  for (uint32_t k = tri_offset_[s]; k < tri_offset_[s + 1]; ++k)
-    for (const uint32_t v : tris_[tri_of_[k]].slot)
-      near.insert(near.end(), tri_of_.begin() + tri_offset_[v], tri_of_.begin() + tri_offset_[v + 1]);
-  std::sort(near.begin(), near.end());
-  near.erase(std::unique(near.begin(), near.end()), near.end());
   double best = std::numeric_limits<double>::infinity();
-  for (const uint32_t t : near) {
+  for (uint32_t q = near_offset_[s]; q < near_offset_[s + 1]; ++q) {
+    const uint32_t t = near_of_[q];
     const SheetTri& T = tris_[t];
     std::array<Vec3, 3> x, d;
     for (int m = 0; m < 3; ++m) {

@@ -189,6 +189,9 @@ class ShellCoupling {
   std::vector<Vec3> edge_out_;
   std::vector<SheetTri> tris_;
   std::vector<uint32_t> tri_offset_, tri_of_;  // by slot: the triangles touching it (CSR)
+  // By slot: the triangles touching it and those touching their vertices, each once, ascending (CSR): the
+  // candidates of closest_on_sheet, fixed by the mesh.
+  std::vector<uint32_t> near_offset_, near_of_;
   ShellWall wall_;
   // Band: rows holding a shell particle, their pairs as built (CSR) and their labels this step.
   std::vector<uint32_t> band_;    // particle indices
