@@ -12,6 +12,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cstdlib>
@@ -106,7 +107,7 @@ TEST_CASE("study: the CI study runs end to end through Snakemake, and a second c
   CHECK(std::vector<std::string>(header.begin(), header.begin() + 5) ==
         std::vector<std::string>{"id", "outlet_pressure_Pa", "spacing_mm", "status", "cycles"});
   CHECK(std::vector<std::string>(header.begin() + 5, header.end()) == requested);
-  std::vector<double> end_diastolic;
+  std::vector<double> outlet_mean;
   for (int v = 0; v < 2; ++v) {
     const auto row = row_map(header, metrics[1 + v]);
     const std::string id = v == 0 ? "v000" : "v001";
@@ -120,7 +121,26 @@ TEST_CASE("study: the CI study runs end to end through Snakemake, and a second c
     for (const auto& m : requested) CHECK(row.at(m) == last.at(m));
     CHECK(!row.at("stroke_volume_ml").empty());
     CHECK(row.at("effective_height_mm").empty());  // a tube has no coaptation probe: empty, not faked
-    end_diastolic.push_back(std::stod(row.at("aortic_end_diastolic_mmHg")));
+    // The mean of the aortic pressure probe (p_out, next to the outlet) over the last cycle, 0.06-0.12 s.
+    const auto probes = csv_rows(out / "variants" / id / "probes.csv");
+    REQUIRE(probes.size() > 1);
+    const auto column = [&](const std::string& name) {
+      const auto it = std::find(probes[0].begin(), probes[0].end(), name);
+      REQUIRE(it != probes[0].end());
+      return static_cast<std::size_t>(it - probes[0].begin());
+    };
+    const std::size_t tc = column("time"), pc = column("p_out");
+    double sum = 0.0;
+    int n = 0;
+    for (std::size_t k = 1; k < probes.size(); ++k) {
+      const double t = std::stod(probes[k][tc]);
+      if (t > 0.06 && t <= 0.12 + 1e-9) {
+        sum += std::stod(probes[k][pc]);
+        ++n;
+      }
+    }
+    REQUIRE(n > 10);
+    outlet_mean.push_back(sum / n);
     // The variant ran with its --set.
     const auto run = nlohmann::json::parse(slurp(out / "variants" / id / "run.json"));
     const std::string set = std::string("open_boundaries.1.pressure=") + (v == 0 ? "41.6" : "141.6");
@@ -131,8 +151,11 @@ TEST_CASE("study: the CI study runs end to end through Snakemake, and a second c
     CHECK(fs::exists(out / "variants" / id / "vtk" / "particles_00060.vtp"));
     CHECK_FALSE(fs::exists(out / "variants" / id / "vtk" / "particles_00001.vtp"));
   }
-  // The outlet pressure reached the runs: 100 Pa (0.75 mmHg) more at the outlet raises the aortic pressure.
-  CHECK(end_diastolic[1] > end_diastolic[0]);
+  // The outlet pressure reached the runs: 100 Pa (0.75 mmHg) more at the outlet raises the aortic pressure by
+  // about as much over the cycle (86 Pa measured at stop 43). The mean, not the end-diastolic sample: the
+  // tube rings by about +-1 mmHg, and one sample put the two variants in either order with small changes
+  // elsewhere.
+  CHECK(outlet_mean[1] - outlet_mean[0] > 50.0);
 
   // report.html: offline, relative links to plots that exist; the header names the model and the BCs.
   const std::string html = slurp(out / "report.html");
@@ -192,7 +215,8 @@ TEST_CASE("study: an interrupted study finishes only the missing variant, resume
   }
   ::setpgid(pid, pid);
   std::string done, running;
-  // Up to 3 minutes: the first variant takes about 10 s on a quiet machine, several times that on a loaded one.
+  // Up to 3 minutes: the first variant takes about 10 s on a quiet machine, several times that on a loaded
+  // one.
   for (int k = 0; k < 18000 && running.empty(); ++k) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     done.clear();
