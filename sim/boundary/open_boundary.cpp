@@ -627,8 +627,12 @@ OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb
       else if (a < 0.0)
         action[i] = kOutflowToFluid;
     } else if (kind == Kind::Fluid) {
+      // Out to the wall's first layer (half a spacing beyond the disc's radius), as at the far face and at a
+      // pressure inlet: fluid by the wall left as fluid inside the buffer, held only by the buffer's imposed
+      // particles and the wall, was pushed into the wall just past the aortic outlet (stop 43).
       if (const int k = zone_of(P.x[i], Kind::Outflow);
-          k >= 0 && zones_[k].axial(P.x[i]) >= 0.0 && zones_[k].radial(P.x[i]) <= zones_[k].spec.radius)
+          k >= 0 && zones_[k].axial(P.x[i]) >= 0.0 &&
+          zones_[k].radial(P.x[i]) <= zones_[k].spec.radius + 0.5 * dx_)
         action[i] = kFluidToOutflow;
       // Fluid pushed back into an inflow buffer (a closed or slow inlet with the column sloshing) is removed
       // only once it is more than a spacing deep, past the buffer's first layer: small back-and-forth motion
