@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "cli_helpers.hpp"
+#include "cycle_report.hpp"
 
 namespace fs = std::filesystem;
 using aortasph::test::scratch;
@@ -122,23 +123,17 @@ TEST_CASE("study: the CI study runs end to end through Snakemake, and a second c
     CHECK(!row.at("stroke_volume_ml").empty());
     CHECK(row.at("effective_height_mm").empty());  // a tube has no coaptation probe: empty, not faked
     // The mean of the aortic pressure probe (p_out, next to the outlet) over the last cycle, 0.06-0.12 s.
-    const auto probes = csv_rows(out / "variants" / id / "probes.csv");
-    REQUIRE(probes.size() > 1);
-    const auto column = [&](const std::string& name) {
-      const auto it = std::find(probes[0].begin(), probes[0].end(), name);
-      REQUIRE(it != probes[0].end());
-      return static_cast<std::size_t>(it - probes[0].begin());
-    };
-    const std::size_t tc = column("time"), pc = column("p_out");
+    const CsvTable probes = read_csv(out / "variants" / id / "probes.csv");
+    const int tc = probes.column("time"), pc = probes.column("p_out");
+    REQUIRE(tc >= 0);
+    REQUIRE(pc >= 0);
     double sum = 0.0;
     int n = 0;
-    for (std::size_t k = 1; k < probes.size(); ++k) {
-      const double t = std::stod(probes[k][tc]);
-      if (t > 0.06 && t <= 0.12 + 1e-9) {
-        sum += std::stod(probes[k][pc]);
+    for (const auto& r : probes.rows)
+      if (r[tc] > 0.06 && r[tc] <= 0.12 + 1e-9) {
+        sum += r[pc];
         ++n;
       }
-    }
     REQUIRE(n > 10);
     outlet_mean.push_back(sum / n);
     // The variant ran with its --set.
