@@ -9,6 +9,7 @@
 #include "boundary/boundary.hpp"
 #include "core/parallel.hpp"
 #include "core/sim_errors.hpp"
+#include "fluid/shifting.hpp"
 #include "fluid/transport_velocity.hpp"
 #include "geometry/shapes.hpp"
 
@@ -102,6 +103,7 @@ World::World(const Scene& scene)
     max_c0_ = std::max(max_c0_, mat.sound_speed);
     max_nu_ = std::max(max_nu_, mat.viscosity);
     shifting_ = shifting_ || mat.shifting > 0.0;
+    shifting_ale_ = shifting_ale_ || fluid_[m].shifting_ale;
     transport_ = transport_ || mat.transport_velocity_pb > 0.0;
   }
   if (!have_fluid) wall_ref_ = FluidParams(Material{});
@@ -454,6 +456,12 @@ void World::step(double dt) {
   // bodies in step_rigid, shells in step_shells): the shift sees their positions at t, as the forces do.
   const ShiftRequest shift{scene_.spacing, dt, &shift_};
   fluid_forces(P_, nb_, ctx, shifting_ ? &shift : nullptr);
+  // The density change the shift makes (ALE; fluid/shifting.hpp), from the positions at t, added here: the
+  // density carried to t + dt is that of the shifted particles, as the continuity equation would have it.
+  if (shifting_ale_) {
+    shift_density_change(P_, nb_, ctx, shift_, shift_drho_);
+    parallel_for(P_.size(), [&](std::size_t i) { P_.rho[i] += shift_drho_[i]; });
+  }
   profile_.forces += seconds_since(t0);
 
   // Forces on body particles from the fluid and from contact (eqs. 23-25).

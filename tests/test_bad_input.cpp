@@ -89,6 +89,10 @@ TEST_CASE("bad input: malformed scenes and arguments exit 2 naming the problem",
                "\"sound_speed\": 10, \"density_summation\": true, "
                "\"transport_velocity\": { \"background_pressure\": 1e12 } }"),
        "", "materials.water.transport_velocity.background_pressure: must not exceed 1000 rho0 c0^2"},
+      // Whether the shift enters the density (materials.<fluid>.shifting_ale).
+      {"shifting_ale not a boolean",
+       replace(good, "\"sound_speed\": 10 }", "\"sound_speed\": 10, \"shifting\": 2, \"shifting_ale\": 1 }"),
+       "", "materials.water.shifting_ale: expected"},
       // A fluid body's jitter (bodies[].jitter, issue 20).
       {"jitter too large",
        replace(good, "\"velocity\": [0, 0, 0],", "\"velocity\": [0, 0, 0], \"jitter\": 0.3,"), "",

@@ -32,8 +32,9 @@ struct FluidParams {
   double riemann_eta = 0.0;  // Riemann-solver dissipation limiter (Zhang, Hu & Adams 2017); 0: off
   double tensile = 0.0;      // Monaghan 2000's artificial-pressure epsilon; 0: off
   double p_background = 0.0;
-  double shifting = 0.0;  // particle shifting coefficient A (fluid/shifting.hpp)
-  double tv_pb = 0.0;     // transport-velocity background pressure p_b (fluid/transport_velocity.hpp)
+  double shifting = 0.0;      // particle shifting coefficient A (fluid/shifting.hpp)
+  bool shifting_ale = false;  // the shift enters the density (fluid/shifting.hpp, shift_density_change)
+  double tv_pb = 0.0;         // transport-velocity background pressure p_b (fluid/transport_velocity.hpp)
   bool summation = false;
 
   explicit FluidParams(const Material& m)
@@ -48,6 +49,7 @@ struct FluidParams {
         tensile(m.tensile_correction),
         p_background(m.background_pressure),
         shifting(m.shifting),
+        shifting_ale(m.shifting > 0.0 && m.shifting_ale && !m.density_summation),
         tv_pb(m.transport_velocity_pb),
         summation(m.density_summation) {}
   FluidParams() = default;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/parallel.hpp"
+#include "fluid/shell_wall.hpp"
 
 namespace aortasph {
 
@@ -15,11 +16,16 @@ void add_shift_ghosts(ShiftSums& s, const Particles& P, const FluidContext& ctx,
   sw.for_each_ghost(xij, i, j, P.body[j], [&](const Vec3& rg) {
     const double rg2 = rg.squaredNorm();
     // Not a boundary to the wall rule (shifting.hpp): the sheet's own coupling keeps the fluid off it.
-    if (rg2 < support2 && rg2 > 0.0) s.add(ctx.kernel, w_dx, rg, rg2, vg, -1);
+    if (rg2 < support2 && rg2 > 0.0) {
+      s.add(ctx.kernel, w_dx, rg, rg2, vg, -1);
+      s.near_sheet = true;
+    }
   });
 }
 
 Vec3 shift_from(const ShiftSums& s, double A, double h, double speed, double dt, double dx) {
+  // Beside a sheet (its imaginary particles in the support): no shift. See shifting.hpp.
+  if (s.near_sheet) return Vec3::Zero();
   if (s.div_r < 1.5) return Vec3::Zero();  // a splash: too few neighbours to tell disorder from emptiness
   Vec3 dr = -(A * h * speed * dt) * s.grad_c;
   if (s.div_r < 2.5) {  // at the free surface: along it only
@@ -75,6 +81,39 @@ void fluid_shifting(const Particles& P, const NeighborSearch& nb, const FluidCon
       add_shift_neighbour(sums, P, ctx, w_dx, i, j, ctx.separation(xi, P.x[j]));
     }
     shift[i] = shift_from(sums, A, K.h, P.v[i].norm(), dt, dx);
+  });
+}
+
+void shift_density_change(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx,
+                          const std::vector<Vec3>& shift, std::vector<double>& drho) {
+  drho.assign(P.size(), 0.0);
+  const auto& idx = nb.index();
+  const CubicSpline& K = ctx.kernel;
+  const double support2 = K.support * K.support;
+  parallel_for_dynamic(P.size(), [&](std::size_t i) {
+    if (P.kind[i] != Kind::Fluid || !ctx.params[P.material[i]].shifting_ale) return;
+    const Vec3 xi = P.x[i];
+    const Vec3 si = shift[i];
+    double d = 0.0;
+    const ShellWall* sw = ctx.shell_wall;
+    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
+      const uint32_t j = idx[k];
+      const Vec3 xij = ctx.separation(xi, P.x[j]);
+      const double r2 = xij.squaredNorm();
+      if (r2 >= support2 || r2 <= 0.0) continue;
+      if (sw && P.kind[j] == Kind::Shell) {
+        sw->for_each_ghost(xij, i, j, P.body[j], [&](const Vec3& rg) {
+          const double rg2 = rg.squaredNorm();
+          if (rg2 >= support2 || rg2 <= 0.0) return;
+          const double rr = std::sqrt(rg2);
+          d += sw->ghost_mass[j] * (K.dWdr(rr) / rr) * si.dot(rg);
+        });
+        continue;
+      }
+      const double r = std::sqrt(r2);
+      d += P.m[j] * (K.dWdr(r) / r) * (si - shift[j]).dot(xij);  // zero shift for all but fluid
+    }
+    drho[i] = d;
   });
 }
 
