@@ -9,7 +9,6 @@
 #include "boundary/boundary.hpp"
 #include "core/parallel.hpp"
 #include "core/sim_errors.hpp"
-#include "fluid/shifting.hpp"
 #include "fluid/transport_velocity.hpp"
 #include "geometry/shapes.hpp"
 
@@ -103,7 +102,6 @@ World::World(const Scene& scene)
     max_c0_ = std::max(max_c0_, mat.sound_speed);
     max_nu_ = std::max(max_nu_, mat.viscosity);
     shifting_ = shifting_ || mat.shifting > 0.0;
-    shifting_ale_ = shifting_ale_ || fluid_[m].shifting_ale;
     transport_ = transport_ || mat.transport_velocity_pb > 0.0;
   }
   if (!have_fluid) wall_ref_ = FluidParams(Material{});
@@ -237,6 +235,7 @@ World::World(const Scene& scene)
   // Inflow buffer particles join the bodies; fluid already beyond an outlet disc becomes outflow buffer.
   if (!scene_.open_boundaries.empty()) open_.setup(scene_, fluid_, P_);
 
+  if (shifting_) P_.shift.assign(P_.size(), Vec3::Zero());  // (Particles::shift; none shifted yet)
   for (std::size_t i = 0; i < P_.size(); ++i)
     if (P_.kind[i] != Kind::Wall) ++moving_at_start_;
   speed_limit_ = scene_.max_speed > 0.0 ? scene_.max_speed : (max_c0_ > 0.0 ? 2.0 * max_c0_ : 1e3);
@@ -435,7 +434,10 @@ void World::step(double dt) {
   }
   fluid_density_summation(P_, nb_, ctx);  // eq. (11), where a material asks for it
   fluid_pair_terms(P_, ctx);
-  fluid_density_rate(P_, nb_, ctx);  // eq. (12) + diffusion, elsewhere
+  // eq. (12) + diffusion, elsewhere; with the last step's shifts where a material counts them in its density
+  // (fluid/shifting.hpp, shift_density_change)
+  ctx.shift_rate = shifting_ ? 1.0 / dt : 0.0;
+  fluid_density_rate(P_, nb_, ctx);
   parallel_for(P_.size(), [&](std::size_t i) {
     if (P_.kind[i] == Kind::Fluid && !fluid_[P_.material[i]].summation) P_.rho[i] += dt * P_.drho[i];
   });
@@ -454,14 +456,8 @@ void World::step(double dt) {
   // eqs. (9), (10), artificial viscosity, gravity; and the particle shifting (Lind et al. 2012) for this
   // step, its sums carried by the same neighbour loop (applied in integrate). Bodies move after this (rigid
   // bodies in step_rigid, shells in step_shells): the shift sees their positions at t, as the forces do.
-  const ShiftRequest shift{scene_.spacing, dt, &shift_};
+  const ShiftRequest shift{scene_.spacing, dt, &P_.shift};
   fluid_forces(P_, nb_, ctx, shifting_ ? &shift : nullptr);
-  // The density change the shift makes (ALE; fluid/shifting.hpp), from the positions at t, added here: the
-  // density carried to t + dt is that of the shifted particles, as the continuity equation would have it.
-  if (shifting_ale_) {
-    shift_density_change(P_, nb_, ctx, shift_, shift_drho_);
-    parallel_for(P_.size(), [&](std::size_t i) { P_.rho[i] += shift_drho_[i]; });
-  }
   profile_.forces += seconds_since(t0);
 
   // Forces on body particles from the fluid and from contact (eqs. 23-25).
@@ -526,7 +522,7 @@ void World::integrate(double dt) {
     P_.v[i] += kick * P_.a[i];
     P_.x[i] += dt * P_.v[i];
     if (!ctx_.transport_dv.empty()) P_.x[i] += dt * ctx_.transport_dv[i];  // dr/dt = v~ (Adami et al. 2013)
-    if (!shift_.empty()) P_.x[i] += shift_[i];
+    if (shifting_) P_.x[i] += P_.shift[i];
     if (per.any) per.wrap(P_.x[i]);  // out through one periodic face, in through the other
   });
   struct Extremes {
@@ -853,7 +849,7 @@ void World::save_state(StateWriter& out) const {
   w.value(static_cast<uint64_t>(moving_at_start_));
   for (const auto& [name, sec] : profile_.phases()) w.value(sec);
 
-  SectionWriter& p = out.section("particles", 1);
+  SectionWriter& p = out.section("particles", 2);  // 2: with the shift (Particles::shift; stop 44)
   p.value(static_cast<uint64_t>(P_.size()));
   P_.for_each_array([&](const char* name, const auto& array) {
     p.string(name);
@@ -946,14 +942,20 @@ void World::load_state(const StateReader& in) {
   // Particles leave the domain; open boundaries also create them, so only scenes without one bound n.
   if (open_.empty() && n > P_.size()) p.mismatch("particles", n, P_.size());
   P_.for_each_array([&](const char* name, auto& array) {
+    if (p.version() < 2 && Particles::optional(name)) {  // written before the array existed: none shifted yet
+      array.clear();
+      return;
+    }
     const std::string stored = p.string();
     if (stored != name)
       throw SetupError("checkpoint section 'particles': array '" + stored + "' where '" + name +
                        "' was expected (another layout)");
     array.clear();
-    p.array(array, name, n);
+    p.array(array, name, Particles::optional(name) ? SIZE_MAX : n);
+    if (!array.empty() && array.size() != n) p.mismatch(name, array.size(), n);
   });
   p.done();
+  if (shifting_ && P_.shift.empty()) P_.shift.assign(n, Vec3::Zero());
   for (std::size_t i = 0; i < n; ++i)
     if (P_.body[i] >= bodies_.size() || P_.material[i] >= scene_.materials.size() ||
         static_cast<uint8_t>(P_.kind[i]) > static_cast<uint8_t>(Kind::Shell))

@@ -240,12 +240,9 @@ class World {
   double min_shell_thickness_ = std::numeric_limits<double>::max();  // the step bound under shell contact
   ShellContact shell_contact_;  // sheets against sheets and walls (active when contact.shell_stiffness > 0)
   double min_contact_mass_ = std::numeric_limits<double>::max();
-  std::vector<Vec3> force_;    // per-particle force on body particles of the current step
-  std::vector<Vec3> shift_;    // particle shifting of the current step (fluid/shifting.hpp); empty when off
-  bool shifting_ = false;      // some fluid material shifts its particles
-  bool shifting_ale_ = false;  // ... and counts the shift in its density
-  std::vector<double> shift_drho_;  // that density change, per particle (fluid/shifting.hpp)
-  bool transport_ = false;          // some fluid material has the transport-velocity formulation
+  std::vector<Vec3> force_;   // per-particle force on body particles of the current step
+  bool shifting_ = false;     // some fluid material shifts its particles
+  bool transport_ = false;    // some fluid material has the transport-velocity formulation
   std::vector<Vec3> moment_;  // and the moment of its contact forces about the particle (contact_dem.hpp)
   Profile profile_;
   double time_ = 0.0;

@@ -355,7 +355,6 @@ TEST_CASE("shell-fluid: particle shifting sees a sheet as a wall, fused and stan
   const double dx = 0.05, w = 0.6, y_sheet = 0.3;
   Material m = water(20.0);
   m.shifting = 2.0;
-  m.shifting_ale = false;  // its density change follows the force loop: see test_periodic.cpp, "carried by"
   Scene s = tank_scene("shift_sheet", dx, Vec3(w, 0.7, w), 20.0, shell_sheet(1e7, 0.3, 0.01));
   s.materials[0] = m;
   s.gravity = Vec3::Zero();

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 #include <type_traits>
 #include <vector>
 
@@ -38,6 +39,10 @@ struct Particles {
   std::vector<uint16_t> body;      // index into the scene's bodies
   std::vector<uint16_t> material;  // index into the scene's materials
   std::vector<uint32_t> id;        // creation index: stable across sorts
+  // Particle shifting (fluid/shifting.hpp): each particle's shift of the last step, applied in
+  // World::integrate and counted in the next step's density (fluid_density_rate). Optional: empty when no
+  // fluid shifts, and resize() and permute() leave it empty then.
+  std::vector<Vec3> shift;
 
   std::size_t size() const { return x.size(); }
 
@@ -59,7 +64,10 @@ struct Particles {
     f("body", body);
     f("material", material);
     f("id", id);
+    f("shift", shift);
   }
+  // An array that may be empty (switched off) while the others hold every particle.
+  static bool optional(const char* name) { return std::strcmp(name, "shift") == 0; }
   template <class F>
   void for_each_array(F&& f) const {
     const_cast<Particles*>(this)->for_each_array(
@@ -68,7 +76,8 @@ struct Particles {
 
   void resize(std::size_t n) {
     // New entries are zero (Kind::Fluid for kind).
-    for_each_array([n](const char*, auto& array) {
+    for_each_array([n](const char* name, auto& array) {
+      if (optional(name) && array.empty()) return;
       using T = typename std::decay_t<decltype(array)>::value_type;
       if constexpr (std::is_same_v<T, Vec3>)
         array.resize(n, Vec3::Zero());
@@ -80,7 +89,9 @@ struct Particles {
   // New order: particle k of the result is particle order[k] of the current arrays. order may be shorter
   // than size() (particles left out are removed).
   void permute(const std::vector<uint32_t>& order) {
-    for_each_array([&order](const char*, auto& array) { apply(array, order); });
+    for_each_array([&order](const char* name, auto& array) {
+      if (!(optional(name) && array.empty())) apply(array, order);
+    });
   }
 
  private:

@@ -72,6 +72,10 @@ struct FluidContext {
   Periodic periodic;                // periodic axes: pair separations are nearest images
   // Shells seen as two-sided walls (fluid/shell_wall.hpp); null when the scene has no shell beside a fluid.
   const ShellWall* shell_wall = nullptr;
+  // 1 / dt of this step when the continuity equation (fluid_density_rate) takes in the particles' shifts of
+  // the last step (Particles::shift, spread over this step as a velocity) for materials with shifting_ale:
+  // the shift counted in the density (fluid/shifting.hpp, shift_density_change). 0: not counted.
+  double shift_rate = 0.0;
   // Per body: 1 for a free-slip boundary body (Body::free_slip), whose particles take no part in the
   // viscous term; empty when every body is no-slip.
   std::vector<uint8_t> free_slip = {};

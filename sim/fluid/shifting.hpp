@@ -119,16 +119,20 @@ void fluid_shifting(const Particles& P, const NeighborSearch& nb, const FluidCon
 //
 //   delta rho_i = sum_j m_j (dr_i - dr_j) . grad_i W_ij,
 //
-// over the same neighbours as eq. (12) (boundary particles and buffers do not shift: dr_j = 0; a sheet's
-// imaginary particles stand for its particles, fluid/shell_wall.hpp). This is the first-order change of the
-// summation density rho_i = sum_j m_j W_ij under the shift, and the divergence term of the ALE form of the
-// continuity equation in the consistent shifting of Sun, Colagrossi, Marrone, Antuono & Zhang 2019 (Comput.
-// Methods Appl. Mech. Engrg. 348:912-934, recalled; the term delta u . grad rho is left out, as in the
-// shifting itself, shifting.hpp). Without it the shift rearranges the particles while their densities stay
-// what the flow made them: shifting packed the physio scene's aorta, 4 % more particles per volume than the
-// density said by 150 ms, and the open boundaries let the surplus in (docs/validation.md, stops 43 and 44).
-// Mass is untouched; the density's total changes only where particles shift towards or away from boundary
-// particles. Gathers: each particle writes only its own entry.
+// over the same neighbours as eq. (12) (boundary particles and buffers that did not shift: dr_j = 0; a
+// sheet's imaginary particles stand for its particles, fluid/shell_wall.hpp). This is the first-order change
+// of the summation density rho_i = sum_j m_j W_ij under the shift, and the divergence term of the ALE form of
+// the continuity equation in the consistent shifting of Sun, Colagrossi, Marrone, Antuono & Zhang 2019
+// (Comput. Methods Appl. Mech. Engrg. 348:912-934, recalled; the term delta u . grad rho is left out, as in
+// the shifting itself). World::step does not call this pass: it keeps each particle's shift
+// (Particles::shift) and the next step's continuity equation takes it in, spread over that step as a
+// velocity, v + dr / dt (fluid_density_rate, FluidContext::shift_rate: one neighbour pass fewer; it costed 16
+// % of the physio scene's step as a pass of its own). This function is the reference the tests compare that
+// with. Without the change the shift rearranges the particles while their densities stay what the flow made
+// them: shifting packed the physio scene's aorta, 4 % more particles per volume than the density said by 150
+// ms, and the open boundaries let the surplus in (docs/validation.md, stops 43 and 44). Mass is untouched;
+// the density's total changes only where particles shift towards or away from boundary particles. Gathers:
+// each particle writes only its own entry.
 void shift_density_change(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx,
                           const std::vector<Vec3>& shift, std::vector<double>& drho);
 
