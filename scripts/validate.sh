@@ -9,7 +9,8 @@
 #   2. With --all, the long studies behind docs/validation.md's tables: scripts/validate_shell.sh (clamped plates,
 #      Scordelis-Lo, roll-up, plates in water), scripts/validate_taylor_green.sh (Re = 100 at lambda/20 and /40)
 #      scripts/validate_dambreak_front.sh (Martin & Moyce front at a/10 to a/30) and scripts/validate_lobovsky.sh
-#      (Lobovsky et al. 2014 wall pressure at H/20 to H/40); each takes 10-30 min.
+#      (Lobovsky et al. 2014 wall pressure at H/20 to H/40); each takes 10-30 min; and
+#      scripts/validate_shift_packing.sh (shifting with open boundaries, about 6 min).
 # Usage: scripts/validate.sh [--all]   (BUILD_DIR=build; builds it with scripts/build.sh when it is missing)
 # Exits non-zero when a case fails; prints each case's duration.
 set -euo pipefail
@@ -45,5 +46,6 @@ if [ "${1:-}" = --all ]; then
   scripts/validate_taylor_green.sh "$build"
   scripts/validate_dambreak_front.sh "$build"
   scripts/validate_lobovsky.sh "$build"
+  scripts/validate_shift_packing.sh "$build"
 fi
 echo "== validations passed in ${SECONDS} s"
