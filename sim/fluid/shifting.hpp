@@ -126,7 +126,7 @@ void fluid_shifting(const Particles& P, const NeighborSearch& nb, const FluidCon
 // (Comput. Methods Appl. Mech. Engrg. 348:912-934, recalled; the term delta u . grad rho is left out, as in
 // the shifting itself). World::step does not call this pass: it keeps each particle's shift
 // (Particles::shift) and the next step's continuity equation takes it in, spread over that step as a
-// velocity, v + dr / dt (fluid_density_rate, FluidContext::shift_rate: one neighbour pass fewer; it costed 16
+// velocity, v + dr / dt (fluid_density_rate, FluidContext::shift_rate: one neighbour pass fewer; it cost 16
 // % of the physio scene's step as a pass of its own). This function is the reference the tests compare that
 // with. Without the change the shift rearranges the particles while their densities stay what the flow made
 // them: shifting packed the physio scene's aorta, 4 % more particles per volume than the density said by 150
