@@ -49,8 +49,9 @@ struct Material {
   double background_pressure = 0.0;  // added to the Tait pressure [Pa]
   double shifting = 0.0;  // particle shifting coefficient A (sim/fluid/shifting.hpp); 0 switches it off
   // The shift's displacement enters the density, as the continuity equation would count it (an ALE
-  // correction, sim/fluid/shifting.hpp); false: the density ignores the shift (before stop 44).
-  bool shifting_ale = true;
+  // correction, sim/fluid/shifting.hpp); off by default (the physio scene with it on stopped at 79 ms, stop
+  // 44).
+  bool shifting_ale = false;
   // Transport-velocity formulation (sim/fluid/transport_velocity.hpp): its background pressure p_b [Pa],
   // which drives the advection velocity only (unlike background_pressure above); 0 switches it off.
   double transport_velocity_pb = 0.0;

@@ -654,7 +654,7 @@ TEST_CASE("aortic root in flow: identical state and probes for 1 and 2 threads",
 TEST_CASE("aortic root in flow: shifting and Riemann dissipation keep the blood from pairing up",
           "[aortic][flow][heavy]") {
   // Issue 20 item 6. The shipped scene regularises the blood (shifting 2, riemann_dissipation 3); without it
-  // the blood pairs up within ten milliseconds of flow (measured here: 16.7 % -> 2.4 % of the blood above the
+  // the blood pairs up within ten milliseconds of flow (measured here: 16.7 % -> 2.7 % of the blood above the
   // annulus with a neighbour closer than dx/2; at 1 mm and 60 ms 19 % -> 0.1 %, docs/validation.md
   // "Regularising the blood"). The blood's nominal volume is not asserted here: at 9 ms it still carries the
   // compression of the 5 ms inflow ramp (+9.4 % plain, +6.8 % regularised).

@@ -46,9 +46,10 @@ std::vector<double> state_of(const World& w) {
 
 Scene fluid_and_block() {
   Scene s = fluid_cubes(0.01);
-  // Shifting on: each particle's shift of the last step (Particles::shift) enters the next step's density,
-  // so it is part of the state the checkpoint must carry.
+  // Shifting on, counted in the density: each particle's shift of the last step (Particles::shift) enters the
+  // next step's density, so it is part of the state the checkpoint must carry.
   s.materials[0].shifting = 2.0;
+  s.materials[0].shifting_ale = true;
   Material steel;
   steel.name = "steel";
   steel.type = MaterialType::Rigid;

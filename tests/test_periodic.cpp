@@ -192,7 +192,9 @@ TEST_CASE("the shift's density change is the change of the summation density, to
   // periodic images), up to second order in the shift: with the shifts scaled by 1/2 the mismatch falls
   // about four times. A sign error or a missing dr_j would leave a mismatch as large as delta rho itself.
   TaylorGreen c;
-  World w(c.scene(10, 10.0, 0.0, 0.1, 2.0));
+  Scene s = c.scene(10, 10.0, 0.0, 0.1, 2.0);
+  s.materials[0].shifting_ale = true;
+  World w(s);
   for (int k = 0; k < 40; ++k) w.step(w.stable_dt());
   const double dx = w.scene().spacing, dt = w.stable_dt();
   const Particles& P = w.particles();

@@ -373,7 +373,7 @@ void fluid_forces(Particles& P, const NeighborSearch& nb, const FluidContext& ct
       if (A > 0.0) add_shift(j);
     }
     P.a[i] = acc + ctx.gravity;
-    if (A > 0.0) (*shift->out)[i] = shift_from(sums, A, ctx.kernel.h, I.v.norm(), shift->dt, shift->dx);
+    if (A > 0.0) (*shift->out)[i] = shift_at(sums, *I.params, ctx.kernel.h, I.v.norm(), shift->dt, shift->dx);
   });
 }
 

@@ -24,8 +24,6 @@ void add_shift_ghosts(ShiftSums& s, const Particles& P, const FluidContext& ctx,
 }
 
 Vec3 shift_from(const ShiftSums& s, double A, double h, double speed, double dt, double dx) {
-  // Beside a sheet (its imaginary particles in the support): no shift. See shifting.hpp.
-  if (s.near_sheet) return Vec3::Zero();
   if (s.div_r < 1.5) return Vec3::Zero();  // a splash: too few neighbours to tell disorder from emptiness
   Vec3 dr = -(A * h * speed * dt) * s.grad_c;
   if (s.div_r < 2.5) {  // at the free surface: along it only
@@ -80,7 +78,7 @@ void fluid_shifting(const Particles& P, const NeighborSearch& nb, const FluidCon
       const uint32_t j = idx[k];
       add_shift_neighbour(sums, P, ctx, w_dx, i, j, ctx.separation(xi, P.x[j]));
     }
-    shift[i] = shift_from(sums, A, K.h, P.v[i].norm(), dt, dx);
+    shift[i] = shift_at(sums, ctx.params[P.material[i]], K.h, P.v[i].norm(), dt, dx);
   });
 }
 

@@ -26,8 +26,9 @@
 // continuity and momentum equations: in a tube between two equal imposed pressures the flow accelerated by
 // itself, 456 -> 835 ml/s in 80 ms (the outflow buffer's push on the fluid 6 % low), where without shifting
 // it stays at 455 -> 430 (docs/validation.md, "Shifting beside walls", stop 42). A shift is capped at 0.1 dx
-// per step. Beside a sheet (its imaginary particles in the support) a particle does not shift at all: with
-// the shift counted in the density (shift_density_change, below), single particles in the pocket at the
+// per step. With the shift counted in the density (shifting_ale; shift_density_change, below), a particle
+// beside a sheet (its imaginary particles in the support) does not shift at all (shift_at): without that rule
+// single particles in the pocket at the
 // valve's centre, where three leaflets meet and the blood ran at 5-10 m/s, shifted by the cap at every step,
 // faster than they moved, and drained to 0.84 rho0 at -130 kPa within 10 ms of the physio scene (stop 44);
 // the sheet's own coupling orders the fluid next to it. The velocity is not Taylor-corrected for the shift
@@ -56,7 +57,7 @@ struct ShiftSums {
   std::array<Vec3, kBodies> boundary;
   std::array<int32_t, kBodies> boundary_body;
   int boundaries = 0;
-  bool near_sheet = false;  // a sheet's imaginary particles are in the support: no shift (shift_from)
+  bool near_sheet = false;  // a sheet's imaginary particles are in the support (shift_at)
   // Neighbour j at x_ij = x_i - x_j (|x_ij|^2 = r2, inside the support), volume V_j = m_j / rho_j;
   // w_dx = W(dx); body: j's body when j is a wall, rigid or elastic particle, -1 for fluid and shells.
   void add(const CubicSpline& K, double w_dx, const Vec3& xij, double r2, double vj, int32_t body) {
@@ -105,6 +106,12 @@ inline void add_shift_neighbour(ShiftSums& s, const Particles& P, const FluidCon
 
 // The shift of a particle with coefficient A, speed |v|, for a step of dt (the surface rule and the cap).
 Vec3 shift_from(const ShiftSums& s, double A, double h, double speed, double dt, double dx);
+// The same for a particle of material f; with the shift counted in the density (f.shifting_ale), none beside
+// a sheet (its imaginary particles in the support; see the header comment).
+inline Vec3 shift_at(const ShiftSums& s, const FluidParams& f, double h, double speed, double dt, double dx) {
+  if (f.shifting_ale && s.near_sheet) return Vec3::Zero();
+  return shift_from(s, f.shifting, h, speed, dt, dx);
+}
 
 // Shift of every fluid particle whose material has shifting > 0 (zero for the others), from the positions
 // and velocities now, for a step of dt. Gathers: each particle writes only its own entry. (World::step has
