@@ -27,13 +27,14 @@
 // itself, 456 -> 835 ml/s in 80 ms (the outflow buffer's push on the fluid 6 % low), where without shifting
 // it stays at 455 -> 430 (docs/validation.md, "Shifting beside walls", stop 42). A shift is capped at 0.1 dx
 // per step. With the shift counted in the density (shifting_ale; shift_density_change, below), a particle
-// beside a sheet (its imaginary particles in the support) does not shift at all (shift_at): without that rule
-// single particles in the pocket at the
-// valve's centre, where three leaflets meet and the blood ran at 5-10 m/s, shifted by the cap at every step,
-// faster than they moved, and drained to 0.84 rho0 at -130 kPa within 10 ms of the physio scene (stop 44);
-// the sheet's own coupling orders the fluid next to it. The velocity is not Taylor-corrected for the shift
-// (as in the Fickian WCSPH schemes of Skillen et al.); the density is, by default, for the shift's
-// divergence (shift_density_change); mass and momentum are untouched, so they stay conserved exactly.
+// beside a sheet (its imaginary particles in the support) does not shift at all (shift_at): without that
+// rule single particles in the pocket at the valve's centre, where three leaflets meet and the blood ran at
+// 5-10 m/s, shifted by the cap at every step, faster than they moved, and drained to 0.84 rho0 at -130 kPa
+// within 10 ms of the physio scene (stop 44); the sheet's own coupling orders the fluid next to it. The
+// velocity is not Taylor-corrected for the shift (as in the Fickian WCSPH schemes of Skillen et al.); the
+// density is only where a material asks for it (shifting_ale, off by default: with it, single particles
+// beside the wall at the commissure posts drained and the physio scene stopped at 79 ms, stop 44); mass and
+// momentum are untouched, so they stay conserved exactly.
 #pragma once
 
 #include <array>
