@@ -435,7 +435,7 @@ void World::step(double dt) {
   fluid_density_summation(P_, nb_, ctx);  // eq. (11), where a material asks for it
   fluid_pair_terms(P_, ctx);
   // eq. (12) + diffusion, elsewhere; with the last step's shifts where a material counts them in its density
-  // (fluid/shifting.hpp, shift_density_change)
+  // (fluid/shifting.hpp)
   ctx.shift_rate = shifting_ ? 1.0 / dt : 0.0;
   fluid_density_rate(P_, nb_, ctx);
   parallel_for(P_.size(), [&](std::size_t i) {

@@ -33,7 +33,7 @@ struct FluidParams {
   double tensile = 0.0;      // Monaghan 2000's artificial-pressure epsilon; 0: off
   double p_background = 0.0;
   double shifting = 0.0;      // particle shifting coefficient A (fluid/shifting.hpp)
-  bool shifting_ale = false;  // the shift enters the density (fluid/shifting.hpp, shift_density_change)
+  bool shifting_ale = false;  // the shift enters the density (fluid/shifting.hpp)
   double tv_pb = 0.0;         // transport-velocity background pressure p_b (fluid/transport_velocity.hpp)
   bool summation = false;
 
@@ -74,7 +74,7 @@ struct FluidContext {
   const ShellWall* shell_wall = nullptr;
   // 1 / dt of this step when the continuity equation (fluid_density_rate) takes in the particles' shifts of
   // the last step (Particles::shift, spread over this step as a velocity) for materials with shifting_ale:
-  // the shift counted in the density (fluid/shifting.hpp, shift_density_change). 0: not counted.
+  // the shift counted in the density (fluid/shifting.hpp). 0: not counted.
   double shift_rate = 0.0;
   // Per body: 1 for a free-slip boundary body (Body::free_slip), whose particles take no part in the
   // viscous term; empty when every body is no-slip.

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "core/parallel.hpp"
-#include "fluid/shell_wall.hpp"
 
 namespace aortasph {
 
@@ -79,39 +78,6 @@ void fluid_shifting(const Particles& P, const NeighborSearch& nb, const FluidCon
       add_shift_neighbour(sums, P, ctx, w_dx, i, j, ctx.separation(xi, P.x[j]));
     }
     shift[i] = shift_at(sums, ctx.params[P.material[i]], K.h, P.v[i].norm(), dt, dx);
-  });
-}
-
-void shift_density_change(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx,
-                          const std::vector<Vec3>& shift, std::vector<double>& drho) {
-  drho.assign(P.size(), 0.0);
-  const auto& idx = nb.index();
-  const CubicSpline& K = ctx.kernel;
-  const double support2 = K.support * K.support;
-  parallel_for_dynamic(P.size(), [&](std::size_t i) {
-    if (P.kind[i] != Kind::Fluid || !ctx.params[P.material[i]].shifting_ale) return;
-    const Vec3 xi = P.x[i];
-    const Vec3 si = shift[i];
-    double d = 0.0;
-    const ShellWall* sw = ctx.shell_wall;
-    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
-      const uint32_t j = idx[k];
-      const Vec3 xij = ctx.separation(xi, P.x[j]);
-      const double r2 = xij.squaredNorm();
-      if (r2 >= support2 || r2 <= 0.0) continue;
-      if (sw && P.kind[j] == Kind::Shell) {
-        sw->for_each_ghost(xij, i, j, P.body[j], [&](const Vec3& rg) {
-          const double rg2 = rg.squaredNorm();
-          if (rg2 >= support2 || rg2 <= 0.0) return;
-          const double rr = std::sqrt(rg2);
-          d += sw->ghost_mass[j] * (K.dWdr(rr) / rr) * si.dot(rg);
-        });
-        continue;
-      }
-      const double r = std::sqrt(r2);
-      d += P.m[j] * (K.dWdr(r) / r) * (si - shift[j]).dot(xij);  // zero shift for all but fluid
-    }
-    drho[i] = d;
   });
 }
 

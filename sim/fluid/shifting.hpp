@@ -26,7 +26,7 @@
 // continuity and momentum equations: in a tube between two equal imposed pressures the flow accelerated by
 // itself, 456 -> 835 ml/s in 80 ms (the outflow buffer's push on the fluid 6 % low), where without shifting
 // it stays at 455 -> 430 (docs/validation.md, "Shifting beside walls", stop 42). A shift is capped at 0.1 dx
-// per step. With the shift counted in the density (shifting_ale; shift_density_change, below), a particle
+// per step. With the shift counted in the density (shifting_ale; see the end of this file), a particle
 // beside a sheet (its imaginary particles in the support) does not shift at all (shift_at): without that
 // rule single particles in the pocket at the valve's centre, where three leaflets meet and the blood ran at
 // 5-10 m/s, shifted by the cap at every step, faster than they moved, and drained to 0.84 rho0 at -130 kPa
@@ -121,27 +121,24 @@ inline Vec3 shift_at(const ShiftSums& s, const FluidParams& f, double h, double 
 void fluid_shifting(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx, double dx,
                     double dt, std::vector<Vec3>& shift);
 
-// The density change of each fluid particle whose material counts the shift in its density (shifting_ale;
-// zero for the others) when every particle moves by its shift: the continuity equation (eq. 12) with the
-// shift's displacement in place of v dt,
+// The shift counted in the density (a material's shifting_ale): the density of each such particle takes in
+// the change the shift makes, the continuity equation (eq. 12) with the shift's displacement in place of
+// v dt,
 //
 //   delta rho_i = sum_j m_j (dr_i - dr_j) . grad_i W_ij,
 //
 // over the same neighbours as eq. (12) (boundary particles and buffers that did not shift: dr_j = 0; a
 // sheet's imaginary particles stand for its particles, fluid/shell_wall.hpp). This is the first-order change
-// of the summation density rho_i = sum_j m_j W_ij under the shift, and the divergence term of the ALE form of
-// the continuity equation in the consistent shifting of Sun, Colagrossi, Marrone, Antuono & Zhang 2019
-// (Comput. Methods Appl. Mech. Engrg. 348:912-934, recalled; the term delta u . grad rho is left out, as in
-// the shifting itself). World::step does not call this pass: it keeps each particle's shift
-// (Particles::shift) and the next step's continuity equation takes it in, spread over that step as a
-// velocity, v + dr / dt (fluid_density_rate, FluidContext::shift_rate: one neighbour pass fewer; it cost 16
-// % of the physio scene's step as a pass of its own). This function is the reference the tests compare that
-// with. Without the change the shift rearranges the particles while their densities stay what the flow made
-// them: shifting packed the physio scene's aorta, 4 % more particles per volume than the density said by 150
-// ms, and the open boundaries let the surplus in (docs/validation.md, stops 43 and 44). Mass is untouched;
-// the density's total changes only where particles shift towards or away from boundary particles. Gathers:
-// each particle writes only its own entry.
-void shift_density_change(const Particles& P, const NeighborSearch& nb, const FluidContext& ctx,
-                          const std::vector<Vec3>& shift, std::vector<double>& drho);
+// of the summation density rho_i = sum_j m_j W_ij under the shift (test: [periodic] "the shift's density
+// change"), and the divergence term of the ALE form of the continuity equation in the consistent shifting of
+// Sun, Colagrossi, Marrone, Antuono & Zhang 2019 (Comput. Methods Appl. Mech. Engrg. 348:912-934, recalled;
+// the term delta u . grad rho is left out, as in the shifting itself). World::step keeps each particle's
+// shift (Particles::shift) and the next step's continuity equation takes it in, spread over that step as a
+// velocity, v + dr / dt (fluid_density_rate, FluidContext::shift_rate): no neighbour pass of its own (as one
+// it cost 16 % of the physio scene's step). Without the change the shift rearranges the particles while their
+// densities stay what the flow made them: shifting packed the physio scene's aorta, 4 % more particles per
+// volume than the density said by 150 ms, and the open boundaries let the surplus in (docs/validation.md,
+// stops 43 and 44). Mass is untouched; the density's total changes only where particles shift towards or
+// away from boundary particles.
 
 }  // namespace aortasph
