@@ -7,8 +7,10 @@
 # geometry 15 s and two shell-contact rests 14 and 13 s, measured on the quiet machine; at stop 27 the shell
 # leaflets' half-spacing case 49 s, the rotated-commissure geometry 32 s and `aortasph check` of the aortic
 # scenes 33 s, on a loaded machine; at stop 34 six 1-vs-2-thread comparisons, 48 s of shard time, which
-# ThreadSanitizer and the Release step check, and the light-sheet barrier case, 16 s), each while other cases
-# cover its code under the sanitizers; they all run in the Release step), a ThreadSanitizer build runs the simulation-render pipeline test, a bounded libFuzzer run
+# ThreadSanitizer and the Release step check, and the light-sheet barrier case, 16 s; at stop 45 the
+# deep-buffer list audit, 30 s, and the pressure inlet beside an off-lattice wall, 26 s, CI having taken 936 s),
+# each while other cases cover its code under the sanitizers; they all run in the Release step), a
+# ThreadSanitizer build runs the simulation-render pipeline test, a bounded libFuzzer run
 # fuzzes the scene loader (scripts/fuzz.sh, built in the same clang sanitizer tree), then the Release build (GCC)
 # runs every test through CTest. The validation-size
 # cases (tag [.validation], hidden from CTest: rigid blocks sinking and floating, the TL-SPH cantilever's energy
@@ -77,9 +79,10 @@ if [ "${AORTASPH_SKIP_SANITIZE:-0}" != 1 ]; then
   [ "$failed" = 0 ] || exit 1
 fi
 if [ "${AORTASPH_SKIP_TSAN:-0}" != 1 ]; then
-  # Only the simulation-render pipeline test, built alone (sim + render + one test file): a few minutes.
+  # Only the simulation-render pipeline test, built alone (sim + render + one test file): a few minutes. -g0 as
+  # in the ASan tree (stop 45): reports name functions, not lines; rebuild with -g1 for file:line.
   echo "== ThreadSanitizer build: simulation-render pipeline test (${SECONDS} s so far)"
-  cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=TSan -DCMAKE_CXX_FLAGS_TSAN="-O1 -g1" -DAORTASPH_TSAN=ON > /dev/null
+  cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=TSan -DCMAKE_CXX_FLAGS_TSAN="-O1 -g0" -DAORTASPH_TSAN=ON > /dev/null
   cmake --build build-tsan --target aortasph_tsan_tests -j "$(nproc)"
   # LP_NUM_THREADS=0: llvmpipe draws on the render thread itself. Its own worker threads synchronise in ways
   # ThreadSanitizer cannot see (reports inside libOSMesa only); frames are identical either way (DESIGN.md).

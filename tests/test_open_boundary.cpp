@@ -436,7 +436,7 @@ ListAudit audit_lists(World& w, int steps) {
 
 TEST_CASE(
     "open boundaries: particles created or leaving at a deep buffer's far face do not force a list build",
-    "[open][neighbors]") {
+    "[open][neighbors][heavy]") {
   // Issue 18 item 1. Four layers (4 dx > support + skin + a spacing of backflow at the velocity inlet): the
   // inflow's new particles get empty rows and the outflow's leaving ones wait, massless, for the next build
   // (when some particle has moved half the skin). Two layers: every such step rebuilds, as before. Either

@@ -853,7 +853,7 @@ TEST_CASE("scenes/aortic_valve_cycle_physio.json loads: the LV waveform inlet an
 }
 
 TEST_CASE("pressure inlet: the buffer's columns keep clear of a wall that is not on their lattice",
-          "[physiology]") {
+          "[physiology][heavy]") {
   // The aortic root's wall is rings of particles half a spacing outside the lumen, not the lattice the
   // inlet's columns are laid on: an inlet disc of the lumen's radius (13 mm, as the physio scene's) had a
   // ring of columns 0.5 spacings from the wall's first layer, and with the left-ventricular pressure behind
