@@ -1,0 +1,128 @@
+#!/usr/bin/env python3
+"""Fluid particles inside walls, frame by frame, from a run's VTK output (aortasph run --vtk).
+
+usage: scripts/wall_leak.py RUN_DIR [--fluid-body N] [--wall-body N ...] [--threshold F] [--list K]
+
+For each fluid particle, the wall fraction is the kernel-weighted volume of the wall particles in its
+support, sum_w dx^3 W(|x - x_w|), with the cubic spline of paper eq. (5) at the run's h (run.json). In the
+open fluid it is 0; beside a flat wall at its resting distance (dx/2 from the first layer's plane) about
+0.37, up to about 0.72 in the aortic root's corners; a particle that has passed the first layer sits among wall
+particles and has 0.8 or more. Particles over --threshold (default 0.8) are counted as inside a wall; the
+--list K deepest of the last frame that has any are printed with their cylindrical coordinates about the
+y axis (the aortic scenes' axis). Bodies are numbered as in the scene (VTK array "body"); by default the
+first fluid body is the fluid and every wall body is a wall.
+
+Reads the ASCII .vtp files aortasph writes; needs numpy only (Debian's python3-numpy, which python3-matplotlib
+of scripts/install-deps.sh brings).
+"""
+import argparse
+import json
+import math
+import os
+import re
+import sys
+
+import numpy as np
+
+
+def read_vtp(path):
+    text = open(path).read()
+    arrays = {}
+    pattern = r'<DataArray type="(\w+)"(?: Name="(\w+)")?(?: NumberOfComponents="(\d+)")? format="ascii">(.*?)</DataArray>'
+    for m in re.finditer(pattern, text, re.S):
+        typ, name, comps, body = m.groups()
+        name = name or "points"
+        if name in arrays:
+            continue
+        a = np.array(body.split(), dtype=float if typ.startswith("Float") else np.int64)
+        arrays[name] = a.reshape(-1, int(comps)) if comps else a
+    return arrays
+
+
+def cubic_spline(r, h):
+    """Paper eq. (5), 3-D: sigma = 1 / (pi h^3), q = r / h, support 2h."""
+    q = r / h
+    w = np.where(q < 1.0, 1.0 - 1.5 * q**2 + 0.75 * q**3, np.where(q < 2.0, 0.25 * (2.0 - q) ** 3, 0.0))
+    return w / (math.pi * h**3)
+
+
+def wall_fraction(xf, xw, dx, h):
+    """sum over wall particles within 2h of each row of xf of dx^3 W: cells of side 2h, the 27 round each."""
+    side = 2.0 * h
+    lo = np.minimum(xf.min(axis=0), xw.min(axis=0)) - side
+    dims = np.ceil((np.maximum(xf.max(axis=0), xw.max(axis=0)) + side - lo) / side).astype(np.int64) + 1
+
+    def key(c):
+        return (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
+
+    cw = np.floor((xw - lo) / side).astype(np.int64)
+    kw = key(cw)
+    order = np.argsort(kw, kind="stable")
+    kw, xw = kw[order], xw[order]
+    cf = np.floor((xf - lo) / side).astype(np.int64)
+    frac = np.zeros(len(xf))
+    for off in np.array(np.meshgrid([-1, 0, 1], [-1, 0, 1], [-1, 0, 1])).T.reshape(-1, 3):
+        k = key(cf + off)
+        begin, end = np.searchsorted(kw, k, "left"), np.searchsorted(kw, k, "right")
+        for n in range(int((end - begin).max(initial=0))):
+            rows = np.where(begin + n < end)[0]
+            r = np.linalg.norm(xw[begin[rows] + n] - xf[rows], axis=1)
+            frac[rows] += dx**3 * cubic_spline(r, h)
+    return frac
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("run_dir")
+    ap.add_argument("--fluid-body", type=int)
+    ap.add_argument("--wall-body", type=int, nargs="*")
+    ap.add_argument("--threshold", type=float, default=0.8)
+    ap.add_argument("--list", type=int, default=5)
+    a = ap.parse_args()
+    try:
+        run = json.load(open(os.path.join(a.run_dir, "run.json")))
+    except (OSError, ValueError) as e:
+        sys.exit(f"{a.run_dir}/run.json: {e}")
+    scene = run["scene"]
+    dx = scene["resolution"]["spacing"]
+    h = scene["resolution"].get("smoothing_ratio", 1.3) * dx
+    mats = scene["materials"]
+    bodies = scene["bodies"]
+    fluid = a.fluid_body
+    if fluid is None:
+        fluid = next((k for k, b in enumerate(bodies) if mats[b["material"]]["type"] == "fluid"), None)
+    walls = a.wall_body
+    if walls is None:
+        walls = [k for k, b in enumerate(bodies) if mats[b["material"]]["type"] == "wall"]
+    if fluid is None or not walls:
+        sys.exit("no fluid or no wall body in the run's scene")
+    vtk = os.path.join(a.run_dir, "vtk")
+    frames = sorted(f for f in os.listdir(vtk) if f.startswith("particles_") and f.endswith(".vtp"))
+    if not frames:
+        sys.exit(f"{vtk}: no particles_*.vtp (run with --vtk)")
+    print(f"# dx {dx} m, h {h} m; fluid body {fluid}, wall bodies {walls}; inside: wall fraction > {a.threshold}")
+    print("frame  fluid  inside  largest_fraction")
+    last = None
+    for f in frames:
+        d = read_vtp(os.path.join(vtk, f))
+        x, body = d["points"], d["body"]
+        fl = np.where(body == fluid)[0]
+        wl = np.isin(body, walls)
+        frac = wall_fraction(x[fl], x[wl], dx, h)
+        inside = frac > a.threshold
+        print(f"{f}  {len(fl)}  {int(inside.sum())}  {frac.max():.3f}")
+        if inside.any():
+            last = (f, x[fl[inside]], frac[inside], d.get("id")[fl[inside]] if "id" in d else None,
+                    d["density"][fl[inside]], d["pressure"][fl[inside]])
+    if last and a.list > 0:
+        f, xs, fr, ids, rho, p = last
+        print(f"# deepest in {f}: id, r [mm], y [mm], theta [deg], wall fraction, density, pressure [Pa]")
+        for k in np.argsort(-fr)[: a.list]:
+            r = math.hypot(xs[k, 0], xs[k, 2]) * 1e3
+            th = math.degrees(math.atan2(xs[k, 2], xs[k, 0]))
+            pid = ids[k] if ids is not None else -1
+            print(f"{pid} {r:.2f} {xs[k, 1] * 1e3:.2f} {th:.1f} {fr[k]:.3f} {rho[k]:.1f} {p[k]:.0f}")
+
+
+if __name__ == "__main__":
+    main()
