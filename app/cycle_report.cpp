@@ -394,6 +394,18 @@ int make_wiggers_plot(const fs::path& dir, std::string& error) {
     // The render block is not needed here (and a run with --end-time may hold figure times past its end).
     nlohmann::json recorded = j["scene"];
     recorded.erase("render");
+    // A run stopped before its cycles' end (--end-time, exit 3, an interrupted run) is plotted as far as it
+    // got: its recorded time.end may be short of the cycles the block asks for, which the loader refuses.
+    if (recorded.contains("cycle") && recorded["cycle"].is_object() && recorded.contains("time") &&
+        recorded["time"].is_object() && recorded["time"].contains("end") &&
+        recorded["time"]["end"].is_number()) {
+      const nlohmann::json& c = recorded["cycle"];
+      if (c.contains("start") && c["start"].is_number() && c.contains("period") && c["period"].is_number() &&
+          c.contains("cycles") && c["cycles"].is_number()) {
+        const double need = c["start"].get<double>() + c["cycles"].get<double>() * c["period"].get<double>();
+        if (recorded["time"]["end"].get<double>() < need) recorded["time"]["end"] = need;
+      }
+    }
     // Files the scene names (a waveform CSV) are relative to the scene file, as when it ran (and as `resume`
     // reads them).
     const fs::path base = j.contains("scene_file") && j["scene_file"].is_string()
