@@ -32,9 +32,10 @@
 // 5-10 m/s, shifted by the cap at every step, faster than they moved, and drained to 0.84 rho0 at -130 kPa
 // within 10 ms of the physio scene (stop 44); the sheet's own coupling orders the fluid next to it. The
 // velocity is not Taylor-corrected for the shift (as in the Fickian WCSPH schemes of Skillen et al.); the
-// density is only where a material asks for it (shifting_ale, off by default: with it, single particles
-// beside the wall at the commissure posts drained and the physio scene stopped at 79 ms, stop 44); mass and
-// momentum are untouched, so they stay conserved exactly.
+// density is only where a material asks for it (shifting_ale, off by default: with it, blood lined up in a
+// commissure post's plane went through the wall above the post from 50 ms, drained there and the physio scene
+// stopped at 79 ms, stops 44-45, scripts/wall_leak.py); mass and momentum are untouched, so they stay
+// conserved exactly.
 #pragma once
 
 #include <array>
