@@ -8,7 +8,8 @@
 # leaflets' half-spacing case 49 s, the rotated-commissure geometry 32 s and `aortasph check` of the aortic
 # scenes 33 s, on a loaded machine; at stop 34 six 1-vs-2-thread comparisons, 48 s of shard time, which
 # ThreadSanitizer and the Release step check, and the light-sheet barrier case, 16 s; at stop 45 the
-# deep-buffer list audit, 30 s, and the pressure inlet beside an off-lattice wall, 26 s, CI having taken 936 s),
+# deep-buffer list audit, 30 s, the pressure inlet beside an off-lattice wall, 26 s, the soft blocks' contact,
+# 15 s, and the barrier beside a free edge's plane, 13 s, CI having taken 936 s),
 # each while other cases cover its code under the sanitizers; they all run in the Release step), a
 # ThreadSanitizer build runs the simulation-render pipeline test, a bounded libFuzzer run
 # fuzzes the scene loader (scripts/fuzz.sh, built in the same clang sanitizer tree), then the Release build (GCC)
@@ -29,7 +30,7 @@ sanitize_tree() {
   scripts/build.sh build-san -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=ASan -DCMAKE_CXX_FLAGS_ASAN="-O1 -g0" \
     -DAORTASPH_SANITIZE=ON -DAORTASPH_FUZZ=ON
 }
-fuzz_run() { scripts/fuzz.sh "${AORTASPH_FUZZ_SECONDS:-60}" build-san; }
+fuzz_run() { scripts/fuzz.sh "${AORTASPH_FUZZ_SECONDS:-40}" build-san; }
 fuzzed=0
 if [ "${AORTASPH_SKIP_SANITIZE:-0}" != 1 ]; then
   echo "== sanitizer build (clang, ASan + UBSan): unit tests"
@@ -44,7 +45,7 @@ if [ "${AORTASPH_SKIP_SANITIZE:-0}" != 1 ]; then
   { ./build-san/tests/aortasph_tests --list-test-names-only "$filter" || true; } | awk 'NF' > build-san/asan-cases.txt
   pids=()
   if [ "${AORTASPH_SKIP_FUZZ:-0}" != 1 ]; then
-    echo "== fuzzing the scene loader for ${AORTASPH_FUZZ_SECONDS:-60} s beside the unit tests (build-san/fuzz.log)"
+    echo "== fuzzing the scene loader for ${AORTASPH_FUZZ_SECONDS:-40} s beside the unit tests (build-san/fuzz.log)"
     fuzz_run > build-san/fuzz.log 2>&1 &
     fuzz_pid=$!
     fuzzed=1
@@ -89,7 +90,7 @@ if [ "${AORTASPH_SKIP_TSAN:-0}" != 1 ]; then
   LP_NUM_THREADS=0 TSAN_OPTIONS=halt_on_error=1 ./build-tsan/tests/aortasph_tsan_tests
 fi
 if [ "${AORTASPH_SKIP_FUZZ:-0}" != 1 ] && [ "$fuzzed" = 0 ]; then
-  echo "== fuzzing the scene loader for ${AORTASPH_FUZZ_SECONDS:-60} s (libFuzzer, clang; ${SECONDS} s so far)"
+  echo "== fuzzing the scene loader for ${AORTASPH_FUZZ_SECONDS:-40} s (libFuzzer, clang; ${SECONDS} s so far)"
   [ -x build-san/tests/aortasph_tests ] || sanitize_tree
   fuzz_run
 fi

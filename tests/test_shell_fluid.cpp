@@ -575,7 +575,8 @@ TEST_CASE("shell-fluid: water close to a curved sheet is on the sheet's side of 
   CHECK(w.shell_crossings() == 0);
 }
 
-TEST_CASE("shell-fluid: the barrier keeps water skimming a free edge's plane on its side", "[shell_fluid]") {
+TEST_CASE("shell-fluid: the barrier keeps water skimming a free edge's plane on its side",
+          "[shell_fluid][heavy]") {
   // Beside a free edge the imaginary particles are beside the fluid particle, not under it, and a particle in
   // the sheet's plane has no pressure pushing it off: without the barrier the guard has to put it back.
   const auto [on, low_on] = skim_free_edge(1.0);

@@ -718,7 +718,7 @@ TEST_CASE(
 TEST_CASE(
     "Contact between elastic bodies only: the step follows the stability bound cfl sqrt(m / k), stays "
     "stable, and the bodies bounce apart",
-    "[solid][contact]") {
+    "[solid][contact][heavy]") {
   // Two soft 4 x 4 x 4 blocks (dx = 5 mm, E = 10 kPa: acoustic step 4.4e-4 s) meet head-on at 0.5 m/s each
   // with contact k = 1000 N/m, so the contact bound cfl sqrt(m / k) = 8.8e-5 s sets the step (with a rigid
   // body in the scene it would be ten times smaller). At that step the contact must be stable: no particle
