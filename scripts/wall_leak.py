@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Fluid particles inside walls, frame by frame, from a run's VTK output (aortasph run --vtk).
 
-usage: scripts/wall_leak.py RUN_DIR [--fluid-body N] [--wall-body N ...] [--threshold F] [--list K]
+usage: scripts/wall_leak.py RUN_DIR [--fluid-body N ...] [--wall-body N ...] [--threshold F] [--list K]
 
 For each fluid particle, the wall fraction is the kernel-weighted volume of the wall particles in its
 support, sum_w dx^3 W(|x - x_w|), with the cubic spline of paper eq. (5) at the run's h (run.json). In the
@@ -10,7 +10,7 @@ open fluid it is 0; beside a flat wall at its resting distance (dx/2 from the fi
 particles and has 0.8 or more. Particles over --threshold (default 0.8) are counted as inside a wall; the
 --list K deepest of the last frame that has any are printed with their cylindrical coordinates about the
 y axis (the aortic scenes' axis). Bodies are numbered as in the scene (VTK array "body"); by default the
-first fluid body is the fluid and every wall body is a wall.
+fluid bodies are the fluid and every wall body is a wall.
 
 Reads the ASCII .vtp files aortasph writes; needs numpy only (Debian's python3-numpy, which python3-matplotlib
 of scripts/install-deps.sh brings).
@@ -74,7 +74,7 @@ def wall_fraction(xf, xw, dx, h):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("run_dir")
-    ap.add_argument("--fluid-body", type=int)
+    ap.add_argument("--fluid-body", type=int, nargs="*")
     ap.add_argument("--wall-body", type=int, nargs="*")
     ap.add_argument("--threshold", type=float, default=0.8)
     ap.add_argument("--list", type=int, default=5)
@@ -90,11 +90,11 @@ def main():
     bodies = scene["bodies"]
     fluid = a.fluid_body
     if fluid is None:
-        fluid = next((k for k, b in enumerate(bodies) if mats[b["material"]]["type"] == "fluid"), None)
+        fluid = [k for k, b in enumerate(bodies) if mats[b["material"]]["type"] == "fluid"]
     walls = a.wall_body
     if walls is None:
         walls = [k for k, b in enumerate(bodies) if mats[b["material"]]["type"] == "wall"]
-    if fluid is None or not walls:
+    if not fluid or not walls:
         sys.exit("no fluid or no wall body in the run's scene")
     vtk = os.path.join(a.run_dir, "vtk")
     frames = sorted(f for f in os.listdir(vtk) if f.startswith("particles_") and f.endswith(".vtp"))
@@ -106,7 +106,7 @@ def main():
     for f in frames:
         d = read_vtp(os.path.join(vtk, f))
         x, body = d["points"], d["body"]
-        fl = np.where(body == fluid)[0]
+        fl = np.where(np.isin(body, fluid))[0]
         wl = np.isin(body, walls)
         frac = wall_fraction(x[fl], x[wl], dx, h)
         inside = frac > a.threshold
