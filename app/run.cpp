@@ -519,6 +519,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
           "aortasph: interrupted at t = %g s; checkpoint written, everything written so far is valid "
           "(continue with: aortasph resume %s)\n",
           world.time(), dir.string().c_str());
+      update_cycles();  // the cycles complete so far, for `aortasph plot` and the resumed run
       write_run_json("interrupted", "");
       code = 130;
     } else {
@@ -537,6 +538,12 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   } catch (const InstabilityError& e) {
     progress.done();
     if (frames) frames->finish_quietly();
+    // The cycles complete before the blow-up (cycles.csv, for `aortasph plot`); the blow-up's own message
+    // is what the run reports, whatever happens here.
+    try {
+      update_cycles();
+    } catch (const std::exception&) {
+    }
     write_run_json("unstable", e.what());
     throw;
   } catch (const std::exception& e) {
