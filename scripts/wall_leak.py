@@ -19,28 +19,17 @@ import argparse
 import json
 import math
 import os
-import re
 import sys
 
 import numpy as np
 
-
-def read_vtp(path):
-    text = open(path).read()
-    arrays = {}
-    pattern = r'<DataArray type="(\w+)"(?: Name="(\w+)")?(?: NumberOfComponents="(\d+)")? format="ascii">(.*?)</DataArray>'
-    for m in re.finditer(pattern, text, re.S):
-        typ, name, comps, body = m.groups()
-        name = name or "points"
-        if name in arrays:
-            continue
-        a = np.array(body.split(), dtype=float if typ.startswith("Float") else np.int64)
-        arrays[name] = a.reshape(-1, int(comps)) if comps else a
-    return arrays
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import study_report  # noqa: E402 (same folder: its .vtp reader)
 
 
 def cubic_spline(r, h):
-    """Paper eq. (5), 3-D: sigma = 1 / (pi h^3), q = r / h, support 2h."""
+    """Paper eq. (5), 3-D: sigma = 1 / (pi h^3), q = r / h, support 2h. (jet_noise.py has the unnormalised
+    shape, but importing it needs scipy.)"""
     q = r / h
     w = np.where(q < 1.0, 1.0 - 1.5 * q**2 + 0.75 * q**3, np.where(q < 2.0, 0.25 * (2.0 - q) ** 3, 0.0))
     return w / (math.pi * h**3)
@@ -104,8 +93,8 @@ def main():
     print("frame  fluid  inside  largest_fraction")
     last = None
     for f in frames:
-        d = read_vtp(os.path.join(vtk, f))
-        x, body = d["points"], d["body"]
+        d = {k: np.asarray(v) for k, v in study_report.read_vtp(os.path.join(vtk, f)).items()}
+        x, body = d["Points"], d["body"].astype(np.int64)
         fl = np.where(np.isin(body, fluid))[0]
         wl = np.isin(body, walls)
         frac = wall_fraction(x[fl], x[wl], dx, h)
@@ -120,7 +109,7 @@ def main():
         for k in np.argsort(-fr)[: a.list]:
             r = math.hypot(xs[k, 0], xs[k, 2]) * 1e3
             th = math.degrees(math.atan2(xs[k, 2], xs[k, 0]))
-            pid = ids[k] if ids is not None else -1
+            pid = int(ids[k]) if ids is not None else -1
             print(f"{pid} {r:.2f} {xs[k, 1] * 1e3:.2f} {th:.1f} {fr[k]:.3f} {rho[k]:.1f} {p[k]:.0f}")
 
 
