@@ -396,15 +396,14 @@ int make_wiggers_plot(const fs::path& dir, std::string& error) {
     recorded.erase("render");
     // A run stopped before its cycles' end (--end-time, exit 3, an interrupted run) is plotted as far as it
     // got: its recorded time.end may be short of the cycles the block asks for, which the loader refuses.
-    if (recorded.contains("cycle") && recorded["cycle"].is_object() && recorded.contains("time") &&
-        recorded["time"].is_object() && recorded["time"].contains("end") &&
-        recorded["time"]["end"].is_number()) {
+    // (NaN where a key is missing or not a number: then nothing changes and the loader names the problem.)
+    const auto number = [](const nlohmann::json& o, const char* key) {
+      return o.is_object() && o.contains(key) && o[key].is_number() ? o[key].get<double>() : std::nan("");
+    };
+    if (recorded.contains("cycle") && recorded.contains("time")) {
       const nlohmann::json& c = recorded["cycle"];
-      if (c.contains("start") && c["start"].is_number() && c.contains("period") && c["period"].is_number() &&
-          c.contains("cycles") && c["cycles"].is_number()) {
-        const double need = c["start"].get<double>() + c["cycles"].get<double>() * c["period"].get<double>();
-        if (recorded["time"]["end"].get<double>() < need) recorded["time"]["end"] = need;
-      }
+      const double need = number(c, "start") + number(c, "cycles") * number(c, "period");
+      if (number(recorded["time"], "end") < need) recorded["time"]["end"] = need;
     }
     // Files the scene names (a waveform CSV) are relative to the scene file, as when it ran (and as `resume`
     // reads them).
