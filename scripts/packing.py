@@ -19,7 +19,7 @@ Distances closer than one spacing are found exactly; the nearest neighbour of a 
 spacing counts as one spacing. Reads the ASCII .vtp files aortasph writes; needs numpy only.
 """
 import argparse
-import json
+import math
 import os
 import re
 import sys
@@ -28,31 +28,22 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import study_report  # noqa: E402 (same folder: its .vtp reader)
+import vtk_run  # noqa: E402
 
 
 def nearest(x, dx):
-    """Distance from each row of x to its nearest other row, capped at dx (cells of side dx, 27 round each)."""
-    lo = x.min(axis=0) - dx
-    c = np.floor((x - lo) / dx).astype(np.int64)
-    dims = c.max(axis=0) + 3
-
-    def key(cc):
-        return (cc[:, 0] * dims[1] + cc[:, 1]) * dims[2] + cc[:, 2]
-
-    k = key(c)
-    order = np.argsort(k, kind="stable")
-    ks, xs = k[order], x[order]
+    """Distance from each row of x to its nearest other row, capped at dx."""
     best = np.full(len(x), dx)
-    for off in np.array(np.meshgrid([-1, 0, 1], [-1, 0, 1], [-1, 0, 1])).T.reshape(-1, 3):
-        kk = key(c + off)
-        begin, end = np.searchsorted(ks, kk, "left"), np.searchsorted(ks, kk, "right")
-        for n in range(int((end - begin).max(initial=0))):
-            rows = np.where(begin + n < end)[0]
-            j = begin[rows] + n
-            d = np.linalg.norm(xs[j] - x[rows], axis=1)
-            d[order[j] == rows] = dx  # not itself
-            best[rows] = np.minimum(best[rows], d)
+    for rows, j in vtk_run.cell_pairs(x, x, dx):
+        d = np.linalg.norm(x[j] - x[rows], axis=1)
+        d[j == rows] = dx  # not itself
+        best[rows] = np.minimum(best[rows], d)
     return best
+
+
+def mean(q, m):
+    """Mean of q over the mask m (NaN where m is empty)."""
+    return float(q[m].mean()) if m.any() else float("nan")
 
 
 def main():
@@ -63,16 +54,9 @@ def main():
     ap.add_argument("--fluid-body", type=int, nargs="*")
     ap.add_argument("--axis-radius", type=float, default=8.0, help="core radius [mm]")
     a = ap.parse_args()
-    try:
-        run = json.load(open(os.path.join(a.run_dir, "run.json")))
-    except (OSError, ValueError) as e:
-        sys.exit(f"{a.run_dir}/run.json: {e}")
-    scene = run["scene"]
+    scene = vtk_run.run_scene(a.run_dir)
     dx = scene["resolution"]["spacing"]
-    mats = scene["materials"]
-    fluid = a.fluid_body
-    if fluid is None:
-        fluid = [k for k, b in enumerate(scene["bodies"]) if mats[b["material"]]["type"] == "fluid"]
+    fluid = a.fluid_body if a.fluid_body is not None else vtk_run.bodies_of_type(scene, "fluid")
     slabs = []
     for s in a.slab:
         try:
@@ -81,10 +65,7 @@ def main():
             sys.exit(f"--slab {s}: expected Y0:Y1 in mm")
         slabs.append((y0, y1))
     vtk = os.path.join(a.run_dir, "vtk")
-    try:
-        frames = sorted(f for f in os.listdir(vtk) if f.endswith(".vtp"))
-    except OSError as e:
-        sys.exit(f"{vtk}: {e}")
+    frames = vtk_run.frames(a.run_dir)
     times = {}  # frame file -> "t = ... s", from the .pvd collection
     try:
         for m in re.finditer(r'timestep="([^"]+)"[^>]*file="([^"]+)"', open(os.path.join(vtk, "particles.pvd")).read()):
@@ -103,10 +84,9 @@ def main():
         for y0, y1 in slabs:
             s = (y >= y0) & (y < y1)
             core, rim = s & (r < a.axis_radius), s & (r >= a.axis_radius)
-            mean = lambda q, m: float(q[m].mean()) if m.any() else float("nan")  # noqa: E731
             cols.append(
                 f"y {y0:g}..{y1:g}: n {int(s.sum())} rho {mean(rho, s):.1f} nn50 "
-                f"{float(np.median(nn[s])) if s.any() else float('nan'):.2f} pairs {mean(nn < 0.5, s):.3f} "
+                f"{float(np.median(nn[s])) if s.any() else math.nan:.2f} pairs {mean(nn < 0.5, s):.3f} "
                 f"core {int(core.sum())} rim {int(rim.sum())} vy_core {mean(v[:, 1], core):+.3f} "
                 f"vy_rim {mean(v[:, 1], rim):+.3f}"
             )

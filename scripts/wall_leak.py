@@ -16,7 +16,6 @@ Reads the ASCII .vtp files aortasph writes; needs numpy only (Debian's python3-n
 of scripts/install-deps.sh brings).
 """
 import argparse
-import json
 import math
 import os
 import sys
@@ -25,6 +24,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import study_report  # noqa: E402 (same folder: its .vtp reader)
+import vtk_run  # noqa: E402
 
 
 def cubic_spline(r, h):
@@ -37,26 +37,9 @@ def cubic_spline(r, h):
 
 def wall_fraction(xf, xw, dx, h):
     """sum over wall particles within 2h of each row of xf of dx^3 W: cells of side 2h, the 27 round each."""
-    side = 2.0 * h
-    lo = np.minimum(xf.min(axis=0), xw.min(axis=0)) - side
-    dims = np.ceil((np.maximum(xf.max(axis=0), xw.max(axis=0)) + side - lo) / side).astype(np.int64) + 1
-
-    def key(c):
-        return (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
-
-    cw = np.floor((xw - lo) / side).astype(np.int64)
-    kw = key(cw)
-    order = np.argsort(kw, kind="stable")
-    kw, xw = kw[order], xw[order]
-    cf = np.floor((xf - lo) / side).astype(np.int64)
     frac = np.zeros(len(xf))
-    for off in np.array(np.meshgrid([-1, 0, 1], [-1, 0, 1], [-1, 0, 1])).T.reshape(-1, 3):
-        k = key(cf + off)
-        begin, end = np.searchsorted(kw, k, "left"), np.searchsorted(kw, k, "right")
-        for n in range(int((end - begin).max(initial=0))):
-            rows = np.where(begin + n < end)[0]
-            r = np.linalg.norm(xw[begin[rows] + n] - xf[rows], axis=1)
-            frac[rows] += dx**3 * cubic_spline(r, h)
+    for rows, j in vtk_run.cell_pairs(xf, xw, 2.0 * h):
+        frac[rows] += dx**3 * cubic_spline(np.linalg.norm(xw[j] - xf[rows], axis=1), h)
     return frac
 
 
@@ -68,27 +51,15 @@ def main():
     ap.add_argument("--threshold", type=float, default=0.8)
     ap.add_argument("--list", type=int, default=5)
     a = ap.parse_args()
-    try:
-        run = json.load(open(os.path.join(a.run_dir, "run.json")))
-    except (OSError, ValueError) as e:
-        sys.exit(f"{a.run_dir}/run.json: {e}")
-    scene = run["scene"]
+    scene = vtk_run.run_scene(a.run_dir)
     dx = scene["resolution"]["spacing"]
     h = scene["resolution"].get("smoothing_ratio", 1.3) * dx
-    mats = scene["materials"]
-    bodies = scene["bodies"]
-    fluid = a.fluid_body
-    if fluid is None:
-        fluid = [k for k, b in enumerate(bodies) if mats[b["material"]]["type"] == "fluid"]
-    walls = a.wall_body
-    if walls is None:
-        walls = [k for k, b in enumerate(bodies) if mats[b["material"]]["type"] == "wall"]
+    fluid = a.fluid_body if a.fluid_body is not None else vtk_run.bodies_of_type(scene, "fluid")
+    walls = a.wall_body if a.wall_body is not None else vtk_run.bodies_of_type(scene, "wall")
     if not fluid or not walls:
         sys.exit("no fluid or no wall body in the run's scene")
     vtk = os.path.join(a.run_dir, "vtk")
-    frames = sorted(f for f in os.listdir(vtk) if f.startswith("particles_") and f.endswith(".vtp"))
-    if not frames:
-        sys.exit(f"{vtk}: no particles_*.vtp (run with --vtk)")
+    frames = vtk_run.frames(a.run_dir)
     print(f"# dx {dx} m, h {h} m; fluid body {fluid}, wall bodies {walls}; inside: wall fraction > {a.threshold}")
     print("frame  fluid  inside  largest_fraction")
     last = None
