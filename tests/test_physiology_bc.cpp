@@ -300,6 +300,7 @@ Scene ptube(const PTube& t) {
 struct Rows {
   std::vector<std::string> columns;
   std::vector<std::vector<double>> rows;  // time first
+  std::vector<std::size_t> outflow;       // the outflow buffers' particles at each row
   double mean(const std::string& name, double t0, double t1) const {
     const std::size_t c = std::find(columns.begin(), columns.end(), name) - columns.begin() + 1;
     REQUIRE(c <= columns.size());
@@ -322,6 +323,7 @@ Rows run(const Scene& s, double t_end, const std::function<void(const World&)>& 
     const auto v = probes.measure(w);
     row.insert(row.end(), v.begin(), v.end());
     r.rows.push_back(row);
+    r.outflow.push_back(w.count(Kind::Outflow));
   }
   if (at_end) at_end(w);
   return r;
@@ -347,9 +349,13 @@ TEST_CASE("pressure inlet: a pressure drop drives Poiseuille flow through a tube
           "[physiology][long]") {
   // nu = 1e-3 m^2/s in a tube of radius R = 4 mm: Re = 2 R V / nu ~ 0.04, developed within R^2 / nu = 16 ms.
   // 40 Pa over 16 mm: V = R^2 dp / (8 mu L) = 5 mm/s. The density varies by dp / (rho c0^2) = 1 %.
-  // At R = 4 spacings the SPH tube's resistance wanders by +-15 % over 0.4 s (the same with a velocity inlet:
-  // the near-wall particles rearrange, and Q goes as R^4), so the flow is compared over 0.04..0.4 s, 25
-  // viscous times.
+  // At R = 4 spacings the SPH tube's resistance drifts down (the same with a velocity inlet: the near-wall
+  // particles rearrange, and Q goes as R^4): the flow over the Poiseuille flow of the measured gradient,
+  // 0.96 at 0.04-0.08 s, 0.94 at 0.12-0.16 s, 1.20 at 0.32-0.40 s, 1.45-1.58 at 0.9-1.2 s (with the outlet
+  // before stop 48: 0.93, 0.88, 1.22, 1.3-1.5). Until stop 48 the flow was compared over 0.04-0.4 s, where
+  // the drift happened to average out (ratio 1.005); it is compared now over 0.04-0.16 s, 2.5-10 viscous
+  // times: developed, before most of the drift (0.938; before stop 48 0.894). The drift is an open
+  // defect of the SPH tube (docs/validation.md, stop 48).
   PTube t;
   const double dp = 40.0;
   for (const int sign : {1, -1}) {
@@ -357,7 +363,7 @@ TEST_CASE("pressure inlet: a pressure drop drives Poiseuille flow through a tube
     t.outlet = 100.0;
     const Scene s = ptube(t);
     std::size_t inflow = 0, outflow = 0;
-    const double t1 = sign > 0 ? 0.4 : 0.1, t0 = 0.04;
+    const double t1 = sign > 0 ? 0.16 : 0.1, t0 = 0.04;
     const Rows r = run(s, t1, [&](const World& w) {
       inflow = w.count(Kind::Inflow);
       outflow = w.count(Kind::Outflow);
@@ -374,7 +380,7 @@ TEST_CASE("pressure inlet: a pressure drop drives Poiseuille flow through a tube
     CHECK(sign * G > 0.5 * dp / L);  // a real drop along the tube
     // Forwards: Poiseuille's law. Backwards (fluid leaves through the pressure inlet, enters through the
     // outlet), over a shorter run: the flow reverses, as large within the wander above.
-    CHECK(std::abs(q_mid / q_poiseuille - 1.0) < (sign > 0 ? 0.05 : 0.15));
+    CHECK(std::abs(q_mid / q_poiseuille - 1.0) < (sign > 0 ? 0.10 : 0.15));
     // The boundaries' flow columns measure the same flow (positive into the domain at the inlet, out of it
     // at the outlet), and their pressure columns the imposed pressures.
     CHECK(std::abs(q_in / q_mid - 1.0) < 0.05);
@@ -388,6 +394,13 @@ TEST_CASE("pressure inlet: a pressure drop drives Poiseuille flow through a tube
     CHECK(inflow < 1.2 * t.layers * columns);
     CHECK(outflow > 0.8 * t.layers * columns);
     CHECK(outflow < 1.2 * t.layers * columns);
+    // The outflow buffer holds its lattice's count at every row: forwards it moves as the fluid at the disc
+    // (carry_disc_velocity). Until stop 48 each layer of it took the velocity of the layer nearer the disc,
+    // which smeared the parabola: the core's columns ran slower at the far face than at the disc and the
+    // buffer piled up to 240 particles by 0.13 s (now at most 216).
+    const std::size_t most = *std::max_element(r.outflow.begin(), r.outflow.end());
+    INFO("outflow buffer at most " << most);
+    CHECK(most < 1.1 * t.layers * columns);
     check_mass_balance(r);
   }
 }

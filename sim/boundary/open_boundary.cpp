@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include "core/parallel.hpp"
@@ -496,6 +497,67 @@ void OpenBoundaries::refill_columns(Particles& P, std::size_t k, std::size_t n,
   }
 }
 
+// Outflow velocity, zero gradient along the axis: every outflow particle takes the normal velocity of the
+// fluid at the point of the disc it lies behind, x - a n (a: its distance from the disc), the Shepard
+// average of the fluid particles within a kernel support of that point (the mirror-point extrapolation of
+// Tafuni, Domínguez, Vacondio & Crespo 2018, Comput. Methods Appl. Mech. Eng. 342:604, to zeroth order and
+// taken at the disc). A column of the buffer thus moves as one: it neither bunches up nor stretches. Until
+// stop 48 each particle averaged its fluid neighbours and the buffer particles nearer the disc, layer by
+// layer, which smeared the disc's profile more at every layer; where the flow came back in through the core
+// of the aortic outlet and left by its wall (a valve cycle's diastole), the columns moved at different
+// speeds at the disc and at the far face, and the backflow's replacements at the far face filled the buffer
+// up (1,582 particles at 0.40 s, 2,126 at 0.74 s; blood pushed through the aortic wall; docs/validation.md,
+// stop 47). Only the normal component: buffer particles feel no wall and must not drift sideways. Kept as
+// it is where no fluid is within a support of that point. Sums in a fixed order (cell, then index): the
+// result does not depend on threads.
+void OpenBoundaries::carry_disc_velocity(Particles& P, const CubicSpline& K, std::size_t n) const {
+  const double h = support_;
+  for (std::size_t k = 0; k < zones_.size(); ++k) {
+    const Zone& z = zones_[k];
+    if (z.spec.type != OpenBoundaryType::Outflow) continue;
+    // The fluid within a support of the disc, by lateral cell (a support wide), and the buffer's particles.
+    const int nr = static_cast<int>(std::ceil((z.spec.radius + 2.0 * h) / h));
+    auto cell = [&](const Vec3& x, int du, int dv) {
+      const Vec3 r = x - z.spec.point;
+      const int64_t cu = static_cast<int64_t>(std::floor(r.dot(z.u) / h)) + du + nr,
+                    cv = static_cast<int64_t>(std::floor(r.dot(z.v) / h)) + dv + nr;
+      return cv * (2 * nr + 2) + cu;
+    };
+    std::vector<std::pair<int64_t, uint32_t>> near;
+    std::vector<uint32_t> buffer;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (P.kind[i] == Kind::Fluid) {
+        if (std::abs(z.axial(P.x[i])) < h && z.radial(P.x[i]) < z.spec.radius + h)
+          near.push_back({cell(P.x[i], 0, 0), static_cast<uint32_t>(i)});
+      } else if (P.kind[i] == Kind::Outflow && !departed(P, i) &&
+                 zone_of(P.x[i], Kind::Outflow) == static_cast<int>(k)) {
+        buffer.push_back(static_cast<uint32_t>(i));
+      }
+    }
+    std::sort(near.begin(), near.end());
+    const Vec3 nrm = z.spec.normal;
+    parallel_for(buffer.size(), [&](std::size_t b) {
+      const uint32_t i = buffer[b];
+      const Vec3 q = P.x[i] - z.axial(P.x[i]) * nrm;  // the point of the disc behind it
+      double sw = 0.0, sv = 0.0;
+      for (int dv = -1; dv <= 1; ++dv)
+        for (int du = -1; du <= 1; ++du) {
+          const int64_t c = cell(q, du, dv);
+          auto it = std::lower_bound(near.begin(), near.end(), std::pair<int64_t, uint32_t>{c, 0});
+          for (; it != near.end() && it->first == c; ++it) {
+            const uint32_t j = it->second;
+            const double r = (q - P.x[j]).norm();
+            if (r >= h) continue;
+            const double w = K.W(r) * P.m[j] / P.rho[j];
+            sw += w;
+            sv += w * P.v[j].dot(nrm);
+          }
+        }
+      if (sw > 0.0) P.v[i] = (sv / sw) * nrm;
+    });
+  }
+}
+
 int OpenBoundaries::column_of(const Zone& z, const Vec3& x) const {
   const Vec3 r = x - z.spec.point;
   const int i = static_cast<int>(std::floor(r.dot(z.u) / dx_)),
@@ -520,11 +582,13 @@ OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb
     }
   }
 
-  // Outflow velocity, zero gradient along the axis: in order of increasing distance from the disc, each
-  // outflow particle takes the Shepard average of its fluid neighbours and of the outflow neighbours nearer
-  // the disc (already updated), so the fluid's velocity at the disc carries through the whole buffer; kept
-  // as it is where no such neighbour is near. Serial, in a fixed order (distance, then index): a few layers
-  // of particles only.
+  carry_disc_velocity(P, K, n);
+
+  // Pressure inlets' velocity, zero gradient along the axis: in order of increasing distance from the disc,
+  // each buffer particle takes the Shepard average of its fluid neighbours and of the buffer neighbours
+  // nearer the disc (already updated), so the fluid's velocity at the disc carries through the whole buffer;
+  // kept as it is where no such neighbour is near. Serial, in a fixed order (distance, then index): a few
+  // layers of particles only. (Outflows until stop 48 too: carry_disc_velocity.)
   const auto& idx = nb.index();
   struct Item {
     double axial;
@@ -536,11 +600,7 @@ OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb
   for (std::size_t i = 0; i < n; ++i)
     if (departed(P, i)) {
       continue;
-    } else if (P.kind[i] == Kind::Outflow) {
-      if (const int k = zone_of(P.x[i], Kind::Outflow); k >= 0)
-        order.push_back({zones_[k].axial(P.x[i]), static_cast<uint32_t>(i), k});
     } else if (P.kind[i] == Kind::Inflow) {
-      // Pressure inlets: the same, mirrored (distance from the disc upstream).
       if (const int k = zone_of(P.x[i], Kind::Inflow); k >= 0 && zones_[k].spec.pressure_inlet)
         order.push_back({-zones_[k].axial(P.x[i]), static_cast<uint32_t>(i), k});
     }
@@ -553,8 +613,7 @@ OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb
     Vec3 sv = Vec3::Zero();
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
-      if (P.kind[j] != Kind::Fluid &&
-          !((P.kind[j] == Kind::Outflow || P.kind[j] == Kind::Inflow) && rank[j] >= 0 && rank[j] < rank[i]))
+      if (P.kind[j] != Kind::Fluid && !(P.kind[j] == Kind::Inflow && rank[j] >= 0 && rank[j] < rank[i]))
         continue;
       const double W = K.W((P.x[i] - P.x[j]).norm()) * P.m[j] / P.rho[j];
       sw += W;
@@ -655,18 +714,38 @@ OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb
     }
   });
 
-  // Outflow particles that stay in their buffer, by zone: a particle coming back through an outlet is
-  // replaced at the buffer's far face only where the buffer has room there (below). Where the buffer's
-  // particles did not move back with it (an outlet at rest, its column jittering across the disc), a
-  // replacement would stack on a particle already there, one more at every swing: in a valve cycle's
-  // diastole that piled 14,000 extra particles into the aortic outlet in 30 ms.
+  // Outflow particles that stay in their buffer, by zone, and how many of them each lattice column (a
+  // spacing-wide cell of the disc's (u, v) frame) holds: a particle coming back through an outlet is
+  // replaced at the buffer's far face only where its column holds fewer than `layers` particles and no
+  // resident particle is within half a spacing (below). Where the buffer's particles did not move back with
+  // it (an outlet at rest, its column jittering across the disc), a replacement would stack on a particle
+  // already there, one more at every swing: in a valve cycle's diastole that piled 14,000 extra particles
+  // into the aortic outlet in 30 ms. The half-spacing room alone still let fluid that swung out into the
+  // buffer (joining it) and back (replaced) add a particle per swing wherever the far face had a
+  // half-spacing gap: in late diastole the aortic outlet's buffer grew from 1,582 particles to 2,126 and fed
+  // the aorta blood packed tighter than its density (docs/validation.md, stops 47-48). The column count
+  // keeps the buffer at its lattice's number of particles.
   // (Pressure inlets keep their buffer full column by column instead: refill_columns below.)
   std::vector<std::vector<Vec3>> resident(zones_.size());
-  if (std::find(action.begin(), action.end(), kOutflowToFluid) != action.end())
+  std::vector<std::map<std::pair<int, int>, int>> column_count(zones_.size());
+  auto lateral_cell = [&](int k, const Vec3& x) {
+    const Vec3 r = x - zones_[k].spec.point;
+    return std::pair<int, int>{static_cast<int>(std::floor(r.dot(zones_[k].u) / dx_)),
+                               static_cast<int>(std::floor(r.dot(zones_[k].v) / dx_))};
+  };
+  if (std::find(action.begin(), action.end(), kOutflowToFluid) != action.end()) {
     for (std::size_t m = 0; m < n; ++m)
-      if (action[m] == kNone && zone[m] >= 0 && P.kind[m] == Kind::Outflow)
+      if (action[m] == kNone && zone[m] >= 0 && P.kind[m] == Kind::Outflow) {
         resident[zone[m]].push_back(P.x[m]);
+        ++column_count[zone[m]][lateral_cell(zone[m], P.x[m])];
+      } else if (action[m] == kFluidToOutflow) {
+        const int k = zone_of(P.x[m], Kind::Outflow);
+        resident[k].push_back(P.x[m]);
+        ++column_count[k][lateral_cell(k, P.x[m])];
+      }
+  }
   auto has_room = [&](int k, const Vec3& x) {
+    if (column_count[k][lateral_cell(k, x)] >= zones_[k].spec.layers) return false;
     for (const Vec3& q : resident[k])
       if ((q - x).squaredNorm() < 0.25 * dx_ * dx_) return false;
     return true;
@@ -696,6 +775,7 @@ OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb
         if (!inflow) {
           if (!has_room(k, x_new)) break;
           resident[k].push_back(x_new);
+          ++column_count[k][lateral_cell(k, x_new)];
         }
         append_buffer_particle(P, x_new, inflow ? Kind::Inflow : Kind::Outflow, i);
         ++created;

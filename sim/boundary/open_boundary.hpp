@@ -217,6 +217,8 @@ class OpenBoundaries {
   // Pressure inlet k: tops up every column of its buffer to `layers` particles (see the .cpp).
   void refill_columns(Particles& P, std::size_t k, std::size_t n, const std::vector<uint8_t>& action,
                       std::size_t& created, bool& rebuild);
+  // Every outflow particle (of the first n) takes the fluid's normal velocity at the disc (see the .cpp).
+  void carry_disc_velocity(Particles& P, const CubicSpline& K, std::size_t n) const;
   // Index of the zone whose buffer holds particle x of the given kind, or -1.
   int zone_of(const Vec3& x, Kind kind) const;
   // Pressure and density of every buffer particle at time t (records each boundary's pressure in flows_).
