@@ -503,13 +503,14 @@ void OpenBoundaries::refill_columns(Particles& P, std::size_t k, std::size_t n,
 // Tafuni, Domínguez, Vacondio & Crespo 2018, Comput. Methods Appl. Mech. Eng. 342:604, to zeroth order and
 // taken at the disc). A column of the buffer thus moves as one: it neither bunches up nor stretches. Until
 // stop 48 each particle averaged its fluid neighbours and the buffer particles nearer the disc, layer by
-// layer, which smeared the disc's profile more at every layer; where the flow came back in through the core
-// of the aortic outlet and left by its wall (a valve cycle's diastole), the columns moved at different
-// speeds at the disc and at the far face, and the backflow's replacements at the far face filled the buffer
-// up (1,582 particles at 0.40 s, 2,126 at 0.74 s; blood pushed through the aortic wall; docs/validation.md,
-// stop 47). Only the normal component: buffer particles feel no wall and must not drift sideways. Kept as
-// it is where no fluid is within a support of that point. Sums in a fixed order (cell, then index): the
-// result does not depend on threads.
+// layer, which smeared the disc's profile more at every layer; where the flow came back in through part of
+// the aortic outlet and left through the rest (a valve cycle's diastole), the columns moved at different
+// speeds at the disc and at the far face, and the backflow's replacements at the far face filled every
+// stretch (with the swing feeding that the column count in update() stops: 1,582 particles at 0.40 s,
+// 2,126 at 0.74 s; blood pushed through the aortic wall; docs/validation.md, stops 47-48). Only the normal
+// component: buffer particles feel no wall and must not drift sideways. Kept as it is where no fluid is
+// within a support of that point. Sums in a fixed order (cell, then index): the result does not depend on
+// threads.
 void OpenBoundaries::carry_disc_velocity(Particles& P, const CubicSpline& K, std::size_t n) const {
   const double h = support_;
   for (std::size_t k = 0; k < zones_.size(); ++k) {
