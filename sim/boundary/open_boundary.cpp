@@ -519,10 +519,8 @@ void OpenBoundaries::carry_disc_velocity(Particles& P, const CubicSpline& K, std
     // The fluid within a support of the disc, by lateral cell (a support wide), and the buffer's particles.
     const int nr = static_cast<int>(std::ceil((z.spec.radius + 2.0 * h) / h));
     auto cell = [&](const Vec3& x, int du, int dv) {
-      const Vec3 r = x - z.spec.point;
-      const int64_t cu = static_cast<int64_t>(std::floor(r.dot(z.u) / h)) + du + nr,
-                    cv = static_cast<int64_t>(std::floor(r.dot(z.v) / h)) + dv + nr;
-      return cv * (2 * nr + 2) + cu;
+      const auto [cu, cv] = z.cell(x, h);
+      return (static_cast<int64_t>(cv) + dv + nr) * (2 * nr + 2) + (static_cast<int64_t>(cu) + du + nr);
     };
     std::vector<std::pair<int64_t, uint32_t>> near;
     std::vector<uint32_t> buffer;
@@ -560,9 +558,7 @@ void OpenBoundaries::carry_disc_velocity(Particles& P, const CubicSpline& K, std
 }
 
 int OpenBoundaries::column_of(const Zone& z, const Vec3& x) const {
-  const Vec3 r = x - z.spec.point;
-  const int i = static_cast<int>(std::floor(r.dot(z.u) / dx_)),
-            j = static_cast<int>(std::floor(r.dot(z.v) / dx_));
+  const auto [i, j] = z.cell(x, dx_);
   if (i < -z.column_nr || i >= z.column_nr || j < -z.column_nr || j >= z.column_nr) return -1;
   return z.column_index[static_cast<std::size_t>((j + z.column_nr) * 2 * z.column_nr + (i + z.column_nr))];
 }
@@ -729,11 +725,7 @@ OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb
   // (Pressure inlets keep their buffer full column by column instead: refill_columns below.)
   std::vector<std::vector<Vec3>> resident(zones_.size());
   std::vector<std::map<std::pair<int, int>, int>> column_count(zones_.size());
-  auto lateral_cell = [&](int k, const Vec3& x) {
-    const Vec3 r = x - zones_[k].spec.point;
-    return std::pair<int, int>{static_cast<int>(std::floor(r.dot(zones_[k].u) / dx_)),
-                               static_cast<int>(std::floor(r.dot(zones_[k].v) / dx_))};
-  };
+  auto lateral_cell = [&](int k, const Vec3& x) { return zones_[k].cell(x, dx_); };
   if (std::find(action.begin(), action.end(), kOutflowToFluid) != action.end()) {
     for (std::size_t m = 0; m < n; ++m)
       if (action[m] == kNone && zone[m] >= 0 && P.kind[m] == Kind::Outflow) {

@@ -67,9 +67,11 @@
 // any thread count, ids stay unique.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/kernel.hpp"
@@ -192,6 +194,11 @@ class OpenBoundaries {
     double radial(const Vec3& x) const {
       const Vec3 r = x - spec.point;
       return (r - r.dot(spec.normal) * spec.normal).norm();
+    }
+    // The cell of side `side` of the disc's (u, v) lattice that x lies behind (or in front of).
+    std::pair<int, int> cell(const Vec3& x, double side) const {
+      const Vec3 r = x - spec.point;
+      return {static_cast<int>(std::floor(r.dot(u) / side)), static_cast<int>(std::floor(r.dot(v) / side))};
     }
     double inflow_speed(const Vec3& x, double t) const;
     // Pressure inlet or outflow: the pressure is prescribed, the velocity carried from the fluid.
