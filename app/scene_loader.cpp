@@ -181,7 +181,7 @@ class Loader {
     Scene s;
     Obj top(root, "",
             {"name", "description", "domain", "resolution", "time", "gravity", "materials", "contact",
-             "aortic_root", "bodies", "open_boundaries", "probes", "cycle", "render"},
+             "aortic_root", "bodies", "open_boundaries", "probes", "cycle", "render", "pressure_gauge"},
             allowed);
     s.name = top.string("name");
     if (s.name.empty() || s.name.find('/') != std::string::npos || s.name == "." || s.name == "..")
@@ -224,6 +224,9 @@ class Loader {
     s.max_density_error = time.non_negative("max_density_error", 0.5);
     s.fixed_dt = time.non_negative("fixed_dt", 0.0);
     if (s.t_end / s.output_interval > 1e6) fail(time.path("output_interval"), "more than a million outputs");
+
+    s.pressure_gauge_open =
+        top.choice("pressure_gauge", {"open_boundaries", "none"}, "open_boundaries") == "open_boundaries";
 
     if (!top.has("gravity")) root["gravity"] = {0.0, -9.81, 0.0};
     s.gravity = top.vec3("gravity");

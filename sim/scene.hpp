@@ -393,6 +393,10 @@ struct Scene {
   std::array<bool, 3>
       periodic{};  // periodic axes x, y, z (sim/core/periodic.hpp): the domain's length is the period
   double max_leave_fraction = 0.0;
+  // The pressure the momentum equation measures from (docs/model.md, "Pressure gauge"): with
+  // `open_boundaries` (the default) the lowest pressure that an open boundary prescribes, less the fluid's
+  // background pressure (never below 0); with `none`, 0.
+  bool pressure_gauge_open = true;
   double spacing = 0.01;
   double smoothing_ratio = 1.3;  // h = smoothing_ratio * spacing
   double t_end = 1.0;

@@ -432,6 +432,9 @@ void World::step(double dt) {
     profile_.boundary += seconds_since(t0);
     t0 = Clock::now();
   }
+  // The pressure the momentum equation measures from (docs/model.md, "Pressure gauge"), from the pressures
+  // the open boundaries imposed at the end of the last step.
+  ctx.gauge = scene_.pressure_gauge_open && !open_.empty() ? open_.pressure_gauge() : 0.0;
   fluid_density_summation(P_, nb_, ctx);  // eq. (11), where a material asks for it
   fluid_pair_terms(P_, ctx);
   // eq. (12) + diffusion, elsewhere; with the last step's shifts where a material counts them in its density

@@ -29,9 +29,10 @@ void boundary_from_fluid(Particles& P, const NeighborSearch& nb, const FluidCont
       return;
     }
     // eq. (27); the moving wall's acceleration a_w enters here. Negative wall pressure is cut to zero so a
-    // free surface touching a wall does not glue the fluid to it (a common practice, e.g. SPHinXsys).
+    // free surface touching a wall does not glue the fluid to it (a common practice, e.g. SPHinXsys); zero
+    // as the momentum equation measures it, from the gauge (ctx.gauge, docs/model.md "Pressure gauge").
     const double p = (sum_pw + (ctx.gravity - P.a[w]).dot(sum_rho_x)) / sum_w;
-    P.p[w] = std::max(p, 0.0);
+    P.p[w] = std::max(p, ctx.gauge);
     P.rho[w] = ref.density(P.p[w]);
     // eq. (22): mirrored fluid velocity for the no-slip viscous term.
     P.v_wall[w] = 2.0 * P.v[w] - sum_v / sum_w;

@@ -323,6 +323,16 @@ double OpenBoundaries::prescribed_inflow_rate(double t) const {
   return q;
 }
 
+double OpenBoundaries::pressure_gauge() const {
+  double gauge = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < zones_.size() && k < flows_.size(); ++k) {
+    const Zone& z = zones_[k];
+    if (z.spec.type == OpenBoundaryType::Inflow && !z.spec.pressure_inlet) continue;  // a velocity inlet
+    gauge = std::min(gauge, flows_[k].pressure - fluid_[z.material].p_background);
+  }
+  return std::isfinite(gauge) ? std::max(gauge, 0.0) : 0.0;
+}
+
 void OpenBoundaries::impose(Particles& P, const Vec3& g, double t) {
   const std::size_t n = P.size();
   const double dx3 = dx_ * dx_ * dx_;

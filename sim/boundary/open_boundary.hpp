@@ -157,6 +157,11 @@ class OpenBoundaries {
   // times spacing^2 (the cross-section that the particles really feed).
   double prescribed_inflow_rate(double t) const;
 
+  // The pressure gauge of the `open_boundaries` rule (docs/model.md, "Pressure gauge"): the lowest pressure
+  // that a boundary imposes now (pressure inlets, outflows: flows()[k].pressure), less its fluid's background
+  // pressure, and never below 0; 0 without such a boundary.
+  double pressure_gauge() const;
+
   const OpenBoundaryState& state() const { return state_; }
   OpenBoundaryState& state() { return state_; }
 

@@ -72,7 +72,7 @@ void fluid_pair_terms(const Particles& P, FluidContext& ctx) {
   ctx.volume.resize(P.size());
   ctx.inv_rho.resize(P.size());
   parallel_for(P.size(), [&](std::size_t i) {
-    ctx.p_over_rho2[i] = P.p[i] / (P.rho[i] * P.rho[i]);
+    ctx.p_over_rho2[i] = (P.p[i] - ctx.gauge) / (P.rho[i] * P.rho[i]);
     ctx.volume[i] = P.m[i] / P.rho[i];
     ctx.inv_rho[i] = 1.0 / P.rho[i];
   });
@@ -177,12 +177,14 @@ inline Vec3 local_wall_term(const FluidContext& ctx, const PairConstants& c, con
   const double r = std::sqrt(r2);
   const double dwdr = ctx.kernel.dWdr(r);
   const Vec3 gradW = (dwdr / r) * r_ig;
-  const double pg = std::max(I.p + I.rho * g_minus_a.dot(-r_ig), 0.0);
-  const double rhog = fi.density(pg);
+  // Pressures measured from the gauge (ctx.gauge, as in fluid_pair_terms); the density from the absolute one.
+  const double pi = I.p - ctx.gauge;
+  const double pg = std::max(pi + I.rho * g_minus_a.dot(-r_ig), 0.0);
+  const double rhog = fi.density(pg + ctx.gauge);
   // The wall pushes and never pulls: i's own pressure enters cut at zero as well. With i in tension (p_i < 0:
   // behind an opening leaflet, in a vortex's core) the term -p_i / rho_i^2 drew i onto the imaginary wall and
   // through the sheet (docs/validation.md, stop 31). Unchanged wherever p_i >= 0.
-  double scalar = -(std::max(I.p, 0.0) / (I.rho * I.rho) + pg / (rhog * rhog));
+  double scalar = -(std::max(pi, 0.0) / (I.rho * I.rho) + pg / (rhog * rhog));
   if (fi.alpha > 0.0) {
     const double vx = vij.dot(r_ig);
     if (vx < 0.0) scalar += fi.alpha * fi.c0 * (c.h * vx / (r2 + c.eta2)) / (0.5 * (I.rho + rhog));

@@ -84,6 +84,11 @@ struct FluidContext {
   // zero where a material has it off; empty when no material has it on.
   std::vector<Vec3> transport_dv = {};
   double inv_w_dx = 0.0;  // 1 / W(particle spacing): the tensile correction's reference (World sets it)
+  // The pressure gauge p_g [Pa] (docs/model.md, "Pressure gauge"): the pair terms of the momentum equation
+  // use p - p_g, one value for every particle, so pair forces still cancel and a uniform pressure still has
+  // no effect, but the zeroth-order error of the SPH gradient, proportional to the pressure itself, is not
+  // multiplied by a pressure level that the flow does not feel. World sets it each step (0: off).
+  double gauge = 0.0;
   // Per particle: 1 / rho, for the viscous term (one division per particle and step, not one per pair).
   std::vector<double> inv_rho = {};
   // x_i - x_j, or its nearest image along periodic axes.
@@ -92,7 +97,7 @@ struct FluidContext {
   }
 };
 
-// Fills ctx.p_over_rho2, ctx.volume and ctx.inv_rho from the current p and rho.
+// Fills ctx.p_over_rho2 ((p - ctx.gauge) / rho^2), ctx.volume and ctx.inv_rho from the current p and rho.
 void fluid_pair_terms(const Particles& P, FluidContext& ctx);
 
 // Density by summation, eq. (11), for fluid particles whose material asks for it.
