@@ -350,13 +350,15 @@ TEST_CASE("pressure inlet: a pressure drop drives Poiseuille flow through a tube
   // nu = 1e-3 m^2/s in a tube of radius R = 4 mm: Re = 2 R V / nu ~ 0.04, developed within R^2 / nu = 16 ms.
   // 40 Pa over 16 mm: V = R^2 dp / (8 mu L) = 5 mm/s. The density varies by dp / (rho c0^2) = 1 %.
   // At R = 4 spacings the open tube's resistance drifts down (the same with a velocity inlet; a periodic
-  // tube of this size driven by a body force does not drift, so it comes from the open boundaries or from
-  // what the probes' gradient measures): the flow over the Poiseuille flow of the measured gradient,
+  // tube of this size driven by a body force does not drift): the flow over the Poiseuille flow of the
+  // measured gradient,
   // 0.96 at 0.04-0.08 s, 0.94 at 0.12-0.16 s, 1.20 at 0.32-0.40 s, 1.45-1.58 at 0.9-1.2 s (with the outlet
   // before stop 48: 0.93, 0.88, 1.22, 1.3-1.5). Until stop 48 the flow was compared over 0.04-0.4 s, where
   // the drift happened to average out (ratio 1.005); it is compared now over 0.04-0.16 s, 2.5-10 viscous
-  // times: developed, before most of the drift (0.938; before stop 48 0.894). The drift is an open
-  // defect of the SPH tube (docs/validation.md, stop 48).
+  // times: developed, before most of the drift (0.938; before stop 48 0.894). The drift comes from the
+  // pressure level, 100-140 Pa over a 40 Pa drive (the SPH gradient's error grows with it; at 40 / 0 Pa the
+  // tube carries 1.10-1.18, as the periodic one does); the background, the margin against tension, keeps
+  // it here (docs/validation.md, stop 49; the "pressure gauge" test below).
   PTube t;
   const double dp = 40.0;
   for (const int sign : {1, -1}) {
@@ -414,29 +416,28 @@ TEST_CASE("pressure gauge: the flow through an open tube does not depend on the 
   // does the physio scene's). Only the difference drives an incompressible flow. The SPH pressure gradient
   // (eq. 9) is not exact for a uniform pressure on a disordered or unevenly packed lattice: its error grows
   // with the pressure itself, and at the higher level it held the fluid nearly still (flow over Poiseuille
-  // 0.14 over 0.04-0.16 s, then ~0.02; 0.95 at the lower level) until the momentum equation measured the
+  // 0.14 over 0.04-0.16 s, then ~0.02; 0.944 at the lower level) until the momentum equation measured the
   // pressure from the gauge, the lowest pressure an open boundary imposes less the background (stop 49):
-  // 0.955 at the higher level, 0.944 at the lower, where the gauge is 0 and nothing changed.
+  // now 0.955 at the higher level; at the lower the gauge is 0 and nothing changed.
   PTube t;
   t.c0 = 10.0;
   const double dp = 40.0, t0 = 0.04, t1 = 0.16;
-  auto ratio = [&](double level, bool gauge) {
+  auto ratio = [&](double level) {
     t.inlet = Waveform{{}, {100.0 + level + dp}, 0.0, 0.0};
     t.outlet = 100.0 + level;
-    Scene s = ptube(t);
-    s.pressure_gauge_open = gauge;
+    const Scene s = ptube(t);  // the gauge on: Scene's default, as the loader's
     double seen = -1.0;
     const Rows r = run(s, t1, [&](const World& w) { seen = w.fluid_context().gauge; });
-    CHECK(seen == Approx(gauge ? level : 0.0));  // min(inlet, outlet) - background
+    CHECK(seen == Approx(level));  // min(inlet, outlet) - background
     const double R = t.radius_dx * t.dx, L = t.length_dx * t.dx, mu = 1060.0 * t.nu;
     const double G = (r.mean("p1", t0, t1) - r.mean("p2", t0, t1)) / (0.5 * L);
     const double q_poiseuille = M_PI * std::pow(R, 4) * G / (8.0 * mu);
     const double q = r.mean("q_mid", t0, t1);
-    UNSCOPED_INFO("level " << level << " Pa, gauge " << (gauge ? "on" : "off") << ": gradient " << G
-                           << " Pa/m, flow " << q << " m^3/s, over Poiseuille " << q / q_poiseuille);
+    UNSCOPED_INFO("level " << level << " Pa: gradient " << G << " Pa/m, flow " << q
+                           << " m^3/s, over Poiseuille " << q / q_poiseuille);
     return q / q_poiseuille;
   };
-  const double low = ratio(0.0, true), high = ratio(1000.0, true);
+  const double low = ratio(0.0), high = ratio(1000.0);
   CHECK(std::abs(low - 1.0) < 0.10);
   CHECK(std::abs(high - 1.0) < 0.10);
   CHECK(std::abs(high - low) < 0.05);

@@ -325,7 +325,7 @@ double OpenBoundaries::prescribed_inflow_rate(double t) const {
 
 double OpenBoundaries::pressure_gauge() const {
   double gauge = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < zones_.size() && k < flows_.size(); ++k) {
+  for (std::size_t k = 0; k < zones_.size(); ++k) {
     const Zone& z = zones_[k];
     if (z.spec.type == OpenBoundaryType::Inflow && !z.spec.pressure_inlet) continue;  // a velocity inlet
     gauge = std::min(gauge, flows_[k].pressure - fluid_[z.material].p_background);
