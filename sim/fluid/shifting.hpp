@@ -26,16 +26,20 @@
 // continuity and momentum equations: in a tube between two equal imposed pressures the flow accelerated by
 // itself, 456 -> 835 ml/s in 80 ms (the outflow buffer's push on the fluid 6 % low), where without shifting
 // it stays at 455 -> 430 (docs/validation.md, "Shifting beside walls", stop 42). A shift is capped at 0.1 dx
-// per step. With the shift counted in the density (shifting_ale; see the end of this file), a particle
-// beside a sheet (its imaginary particles in the support) does not shift at all (shift_at): without that
-// rule single particles in the pocket at the valve's centre, where three leaflets meet and the blood ran at
-// 5-10 m/s, shifted by the cap at every step, faster than they moved, and drained to 0.84 rho0 at -130 kPa
-// within 10 ms of the physio scene (stop 44); the sheet's own coupling orders the fluid next to it. The
-// velocity is not Taylor-corrected for the shift (as in the Fickian WCSPH schemes of Skillen et al.); the
-// density is only where a material asks for it (shifting_ale, off by default: with it, blood lined up in a
-// commissure post's plane went through the wall above the post from 50 ms, drained there and the physio scene
-// stopped at 79 ms, stops 44-45, scripts/wall_leak.py); mass and momentum are untouched, so they stay
-// conserved exactly.
+// per step. A particle beside a sheet (a shell's imaginary particles in its support) does not shift at all
+// (shift_at); the sheet's own coupling orders the fluid next to it. Stop 44 made that rule for shifting_ale
+// (see the end of this file): single particles in the pocket at the valve's centre, where three leaflets
+// meet and the blood ran at 5-10 m/s, shifted by the cap at every step, faster than they moved, and drained
+// to 0.84 rho0 at -130 kPa within 10 ms of the physio scene. Stop 50 made it for every material: without the
+// shift counted in the density, those shifts moved particles apart without their density falling, so the
+// blood that passed the leaflets filled 6-12 % more volume than its density said (Voronoi volumes of the
+// physio run's particles), the aorta lost 15 % of its particles in ejection while its density held, and the
+// continuity density (eq. 12) never saw it; a flap in a tube shows the same (test [shell_fluid] "blood
+// flowing past a flap"). The velocity is not Taylor-corrected for the shift (as in the Fickian WCSPH schemes
+// of Skillen et al.); the density is only where a material asks for it (shifting_ale, off by default: with
+// it, blood lined up in a commissure post's plane went through the wall above the post from 50 ms, drained
+// there and the physio scene stopped at 79 ms, stops 44-45, scripts/wall_leak.py); mass and momentum are
+// untouched, so they stay conserved exactly.
 #pragma once
 
 #include <array>
@@ -108,10 +112,10 @@ inline void add_shift_neighbour(ShiftSums& s, const Particles& P, const FluidCon
 
 // The shift of a particle with coefficient A, speed |v|, for a step of dt (the surface rule and the cap).
 Vec3 shift_from(const ShiftSums& s, double A, double h, double speed, double dt, double dx);
-// The same for a particle of material f; with the shift counted in the density (f.shifting_ale), none beside
-// a sheet (its imaginary particles in the support; see the header comment).
+// The same for a particle of material f: none beside a sheet (its imaginary particles in the support; see the
+// header comment).
 inline Vec3 shift_at(const ShiftSums& s, const FluidParams& f, double h, double speed, double dt, double dx) {
-  if (f.shifting_ale && s.near_sheet) return Vec3::Zero();
+  if (s.near_sheet) return Vec3::Zero();
   return shift_from(s, f.shifting, h, speed, dt, dx);
 }
 
