@@ -678,9 +678,10 @@ TEST_CASE(
     "[shell_fluid][long]") {
   // A flap (a 6 x 7 mm sheet, 0.45 mm leaflet tissue, clamped along its upstream edge) in a tube of radius
   // 6 mm between a pressure inlet and outlet 500 Pa apart, with the physio scene's blood (shifting 2) at
-  // c0 = 20 m/s. The flow reaches about 1 m/s in 10 ms. Measure: the summation density of the fluid,
-  // sum_j m_j W_ij, over the continuity density rho_i (eq. 12), for the particles whose support holds only
-  // fluid (no wall, no sheet): 1 while the particles fill the volume that their masses and densities say.
+  // c0 = 20 m/s. In 10 ms the flow reaches 0.35 m/s on average (0.6 m/s at most). Measure: the summation
+  // density of the fluid, sum_j m_j W_ij, over the continuity density rho_i (eq. 12), for the particles whose
+  // support holds only fluid (no wall, no sheet): 1 while the particles fill the volume that their masses and
+  // densities say.
   // Until stop 50 particles beside the sheet shifted without their density changing, and the shift created
   // volume that the continuity density never saw: here 0.976, 0.977, 0.978 at 5, 7.5, 10 ms; in the physio
   // scene the blood that passed the leaflets filled 6-12 % more volume than its density said, and the
@@ -749,7 +750,7 @@ TEST_CASE(
   INFO("start " << start << " over " << n0 << " particles; mean " << mean << ", lowest " << worst
                 << "; fastest fluid particle " << speed << " m/s; put-backs " << world.shell_crossings());
   CHECK(start == Approx(1.0).margin(0.005));  // the lattice
-  CHECK(speed > 0.5);                         // the blood flows past the flap
+  CHECK(speed > 0.4);                         // the blood flows past the flap (0.63 m/s)
   CHECK(mean > 0.99);
   CHECK(worst > 0.98);
   CHECK(world.shell_crossings() == 0);
