@@ -74,7 +74,6 @@ def main():
     if len(edges) < 2 or any(b <= c for c, b in zip(edges, edges[1:])):
         sys.exit(f"--bins {a.bins}: expected at least two increasing edges")
     scene = vtk_run.run_scene(a.run_dir)
-    kinds = {k: scene["materials"][b["material"]]["type"] for k, b in enumerate(scene["bodies"])}
     for frame in a.frames:
         idx, ratio, d = ratios(a.run_dir, frame, scene, edges[0], edges[-1])
         y = d["Points"][idx, 1] * 1e3
@@ -89,8 +88,8 @@ def main():
 
         x = d["Points"]
         body = d["body"].astype(int)
-        shell = np.isin(body, [k for k, t in kinds.items() if t == "shell"])
-        wall = np.isin(body, [k for k, t in kinds.items() if t == "wall"])
+        shell = np.isin(body, vtk_run.bodies_of_type(scene, "shell"))
+        wall = np.isin(body, vtk_run.bodies_of_type(scene, "wall"))
         if not shell.any() or not wall.any():
             sys.exit(f"{a.run_dir}: --near-sheet needs shell and wall bodies")
         ds = cKDTree(x[shell]).query(x[idx])[0] * 1e3
