@@ -352,12 +352,12 @@ TEST_CASE("pressure inlet: a pressure drop drives Poiseuille flow through a tube
   // At R = 4 spacings the open tube's resistance drifts down (the same with a velocity inlet; a periodic
   // tube of this size driven by a body force does not drift): the flow over the Poiseuille flow of the
   // measured gradient, 0.96 at 0.04-0.08 s, 0.94 at 0.12-0.16 s, 1.20 at 0.32-0.40 s, 1.45-1.58 at 0.9-1.2 s
-  // (with the outlet before stop 48: 0.93, 0.88, 1.22, 1.3-1.5). Until stop 48 the flow was compared over 0.04-0.4 s, where
-  // the drift happened to average out (ratio 1.005); it is compared now over 0.04-0.16 s, 2.5-10 viscous
-  // times: developed, before most of the drift (0.938; before stop 48 0.894). The drift comes from the
-  // pressure level, 100-140 Pa over a 40 Pa drive (the SPH gradient's error grows with it; at 40 / 0 Pa the
-  // tube carries 1.10-1.18, as the periodic one does); the background, the margin against tension, keeps
-  // it here (docs/validation.md, stop 49; the "pressure gauge" test below).
+  // (with the outlet before stop 48: 0.93, 0.88, 1.22, 1.3-1.5). Until stop 48 the flow was compared over
+  // 0.04-0.4 s, where the drift happened to average out (ratio 1.005); it is compared now over 0.04-0.16
+  // s, 2.5-10 viscous times: developed, before most of the drift (0.938; before stop 48 0.894). The drift
+  // comes from the pressure level, 100-140 Pa over a 40 Pa drive (the SPH gradient's error grows with it; at
+  // 40 / 0 Pa the tube carries 1.10-1.18, as the periodic one does); the background, the margin against
+  // tension, keeps it here (docs/validation.md, stop 49; the "pressure gauge" test below).
   PTube t;
   const double dp = 40.0;
   for (const int sign : {1, -1}) {
