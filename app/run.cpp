@@ -104,9 +104,11 @@ class Progress {
 
 std::vector<std::string> diagnostics_columns() {
   // shell_crossings: the guard's put-backs since t = 0 (fluid particles stopped at a sheet; 0 without
-  // shells).
-  std::vector<std::string> cols = {"steps",    "dt",        "particles",         "fluid",
-                                   "boundary", "max_speed", "max_density_error", "shell_crossings"};
+  // shells). volume_ratio: the mean summation density over the continuity density of the fluid whose support
+  // holds only fluid (sim/fluid/volume_check.hpp; NaN where no fluid particle has a full support).
+  std::vector<std::string> cols = {"steps",       "dt",        "particles",         "fluid",
+                                   "boundary",    "max_speed", "max_density_error", "shell_crossings",
+                                   "volume_ratio"};
   for (const auto& [name, sec] : Profile{}.phases()) cols.push_back("wall_" + name);
   cols.push_back("wall_total");
   return cols;
@@ -123,7 +125,8 @@ std::vector<double> diagnostics_row(const World& w) {
                              n - fluid,
                              w.max_speed(),
                              w.max_density_error(),
-                             static_cast<double>(w.shell_crossings())};
+                             static_cast<double>(w.shell_crossings()),
+                             w.fluid_volume_check().mean};
   for (const auto& [name, sec] : w.profile().phases()) row.push_back(sec);
   row.push_back(w.profile().total());
   return row;

@@ -833,6 +833,10 @@ double World::max_density_error() const {
       [](double a, double b) { return std::max(a, b); });
 }
 
+VolumeCheck World::fluid_volume_check() const {
+  return aortasph::fluid_volume_check(P_, kernel_, nb_.periodic());
+}
+
 std::size_t World::memory_bytes() const {
   const std::size_t per =
       sizeof(Vec3) * 5 + sizeof(double) * 4 + sizeof(Kind) + 2 * sizeof(uint16_t) + sizeof(uint32_t);

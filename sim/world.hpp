@@ -14,6 +14,7 @@
 #include "core/neighbors.hpp"
 #include "core/particles.hpp"
 #include "fluid/fluid_wcsph.hpp"
+#include "fluid/volume_check.hpp"
 #include "geometry/shapes.hpp"
 #include "io/checkpoint.hpp"
 #include "io/snapshot.hpp"
@@ -176,6 +177,8 @@ class World {
   std::size_t left_domain() const { return left_domain_; }
   // max |rho / rho0 - 1| over fluid particles.
   double max_density_error() const;
+  // Summation density over continuity density of the fluid with a full support (fluid/volume_check.hpp).
+  VolumeCheck fluid_volume_check() const;
   // Bytes held by particle arrays and neighbour lists.
   std::size_t memory_bytes() const;
 

@@ -86,7 +86,9 @@ TEST_CASE("cli: a small scene runs and writes probes, diagnostics and run.json",
   CHECK(probes.rfind("time,front\n", 0) == 0);
   CHECK(std::count(probes.begin(), probes.end(), '\n') == 4);  // header + t = 0, 0.001, 0.002
   CHECK(probes.find("\n0.002,") != std::string::npos);         // output times are exact
-  CHECK(fs::exists(dir / "out" / "diagnostics.csv"));
+  // diagnostics.csv holds the volume check (fluid/volume_check.hpp) beside the density error.
+  CHECK(slurp(dir / "out" / "diagnostics.csv").find(",max_density_error,shell_crossings,volume_ratio,") !=
+        std::string::npos);
   CHECK(slurp(dir / "out" / "run.json").find("\"status\": \"ok\"") != std::string::npos);
   CHECK(fs::exists(dir / "out" / "vtk" / "particles_00002.vtp"));
   CHECK(slurp(dir / "out" / "vtk" / "particles.pvd").find("particles_00002.vtp") != std::string::npos);
