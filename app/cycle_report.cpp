@@ -210,12 +210,18 @@ std::vector<CycleMetrics> cycle_metrics_of(const Scene& s, const CsvTable& table
         sig.wall_min_cusp.push_back(col(c.wall_distance + ".min_" + std::to_string(k)));
     }
   if (diagnostics) {
-    const int dt = diagnostics->column("time"), de = diagnostics->column("max_density_error");
+    const int dt = diagnostics->column("time"), de = diagnostics->column("max_density_error"),
+              dv = diagnostics->column("volume_ratio");  // absent from runs before stop 51
     if (dt >= 0 && de >= 0 && !diagnostics->rows.empty()) {
-      std::vector<double> t, e;
+      std::vector<double> t, e, v;
       for (const auto& r : diagnostics->rows)
-        if (t.empty() || r[dt] > t.back()) t.push_back(r[dt]), e.push_back(r[de]);
+        if (t.empty() || r[dt] > t.back()) {
+          t.push_back(r[dt]), e.push_back(r[de]);
+          if (dv >= 0) v.push_back(r[dv]);
+        }
       for (const double x : sig.t) sig.density_error.push_back(sample(t, e, x));
+      if (dv >= 0)
+        for (const double x : sig.t) sig.volume_ratio.push_back(sample(t, v, x));
     }
   }
   CycleOptions o;

@@ -264,6 +264,12 @@ TEST_CASE("cycle block: a short pulsatile tube run writes cycles.csv, run.json m
   REQUIRE(cycles.column("max_density_error_pct") >= 0);
   CHECK(cycles.rows[0][cycles.column("max_density_error_pct")] == Approx(100.0 * largest));
   CHECK(largest > 0.0);
+  // The volume check's range per cycle (fluid/volume_check.hpp), from the same file: in this 2 mm tube
+  // (radius 2.5 spacings) no fluid particle's support holds only fluid, so every row is NaN and so are the
+  // cycle's (written empty); the values are checked on synthetic signals ("... density error per cycle").
+  for (const auto& row : diag.rows) CHECK(std::isnan(row[diag.column("volume_ratio")]));
+  CHECK(std::isnan(cycles.rows[0][cycles.column("volume_ratio_min")]));
+  CHECK(std::isnan(cycles.rows[0][cycles.column("volume_ratio_max")]));
   // No valve: the orifice metrics are empty, not zero.
   CHECK(std::isnan(cycles.rows[1][cycles.column("peak_goa_cm2")]));
   CHECK(std::isfinite(cycles.rows[1][cycles.column("sv_change_pct")]));
@@ -840,7 +846,13 @@ TEST_CASE("valve metrics: acoustic noise of the LV pressure and the largest dens
   CycleSignals s = synthetic({400e-6}, {80.0});
   for (const double x : s.t)
     s.density_error.push_back(0.004 + 0.008 * std::exp(-std::pow((x - 0.5) / 0.01, 2)));
+  // The volume check: 0.997 with a dip to 0.947 at 0.2 s and a bump to 1.017 at 0.6 s.
+  for (const double x : s.t)
+    s.volume_ratio.push_back(0.997 - 0.05 * std::exp(-std::pow((x - 0.2) / 0.01, 2)) +
+                             0.02 * std::exp(-std::pow((x - 0.6) / 0.01, 2)));
   const CycleMetrics quiet = all_cycle_metrics(s, o).at(0);
+  CHECK(quiet.volume_ratio_min == Approx(0.947).epsilon(1e-4));
+  CHECK(quiet.volume_ratio_max == Approx(1.017).epsilon(1e-4));
   // Noise of +-300 Pa alternating sample by sample over 0.05-0.25 s: a window of 11 samples holds 5 of the
   // sample's sign and 6 of the other, so the deviation is 300 (1 + 1/11) Pa.
   int noisy_samples = 0, counted = 0;
@@ -871,6 +883,8 @@ TEST_CASE("valve metrics: acoustic noise of the LV pressure and the largest dens
   }
   const CycleMetrics m2 = all_cycle_metrics(thin, o).at(0);
   CHECK(std::isnan(m2.max_density_error_pct));
+  CHECK(std::isnan(m2.volume_ratio_min));
+  CHECK(std::isnan(m2.volume_ratio_max));
   CHECK(std::isnan(m2.lv_noise_Pa));
   CHECK(std::isfinite(m2.stroke_volume_ml));
 }

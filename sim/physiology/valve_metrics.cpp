@@ -373,6 +373,8 @@ CycleMetrics cycle_metrics(const CycleSignals& s, double t0, double t1, const Cy
   // the LV pressure during forward flow (RMS about its 10 ms centred running mean, from samples <= 1 ms
   // apart).
   m.max_density_error_pct = has(s.density_error) ? 100.0 * max_in(t, s.density_error, t0, t1) : kNaN;
+  m.volume_ratio_min = has(s.volume_ratio) ? min_in(t, s.volume_ratio, t0, t1) : kNaN;
+  m.volume_ratio_max = has(s.volume_ratio) ? max_in(t, s.volume_ratio, t0, t1) : kNaN;
   m.lv_noise_Pa = has(s.lv_pressure) && ejection
                       ? running_mean_rms(t, s.lv_pressure, tf0, tf1, kNoiseWindow, kNoiseMaxSpacing)
                       : kNaN;
@@ -470,6 +472,8 @@ std::vector<std::pair<std::string, double>> metric_table(const CycleMetrics& m) 
     r.emplace_back("leaflet_wall_min_systole_c" + std::to_string(c) + "_mm",
                    m.leaflet_wall_min_systole_mm_per[c]);
   r.emplace_back("max_density_error_pct", m.max_density_error_pct);
+  r.emplace_back("volume_ratio_min", m.volume_ratio_min);
+  r.emplace_back("volume_ratio_max", m.volume_ratio_max);
   r.emplace_back("lv_noise_Pa", m.lv_noise_Pa);
   r.emplace_back("sv_change_pct", m.sv_change_pct);
   r.emplace_back("edp_change_pct", m.edp_change_pct);

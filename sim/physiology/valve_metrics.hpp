@@ -43,6 +43,9 @@ struct CycleSignals {
   std::vector<std::vector<double>> wall_min_cusp;
   // The fluid's largest relative density error |rho / rho0 - 1| (diagnostics.csv's max_density_error) [-].
   std::vector<double> density_error;
+  // The fluid's summation density over its continuity density (diagnostics.csv's volume_ratio,
+  // fluid/volume_check.hpp) [-].
+  std::vector<double> volume_ratio;
 };
 
 struct CycleOptions {
@@ -87,6 +90,9 @@ struct CycleMetrics {
   // Largest density error in the cycle [%]; noise of the LV pressure during forward flow [Pa]: the RMS about
   // its centred running mean over kNoiseWindow, NaN unless the samples are kNoiseMaxSpacing apart or closer.
   double max_density_error_pct = 0, lv_noise_Pa = 0;
+  // Lowest and highest volume_ratio in the cycle (NaN without it): away from the lattice's value the
+  // particles stand farther apart (lower) or closer (higher) than their densities say.
+  double volume_ratio_min = 0, volume_ratio_max = 0;
   // Periodic state, against the previous cycle (NaN for the first).
   double sv_change_pct = 0, edp_change_pct = 0;
   bool periodic = false;
