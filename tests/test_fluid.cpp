@@ -271,6 +271,13 @@ TEST_CASE("the volume check reads the kernel's lattice sum on a lattice and sees
     INFO("stretch " << stretch << ": mean " << c.mean << ", lattice sum " << lattice_sum(s));
     CHECK(c.particles == 1000);
     CHECK(c.mean == Approx(lattice_sum(s)).epsilon(1e-12));
+    // Through Verlet lists with a skin (the World's at an output): the pairs beyond the support skipped.
+    NeighborSearch verlet;
+    verlet.set_periodic(per);
+    verlet.build(P.x, 1.1 * K.support);
+    const VolumeCheck v = fluid_volume_check(P, K, per, &verlet);
+    CHECK(v.particles == c.particles);
+    CHECK(v.mean == Approx(c.mean).epsilon(1e-12));
     if (stretch == 1.0)
       CHECK(std::abs(c.mean - 0.99726) < 1e-5);  // docs/validation.md, "Kernel"
     else

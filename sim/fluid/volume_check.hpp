@@ -12,6 +12,7 @@
 #include <cstddef>
 
 #include "core/kernel.hpp"
+#include "core/neighbors.hpp"
 #include "core/particles.hpp"
 #include "core/periodic.hpp"
 
@@ -22,8 +23,10 @@ struct VolumeCheck {
   std::size_t particles = 0;  // the fluid particles whose support holds only fluid
 };
 
-// Builds its own cell lists at the kernel's support (the World's Verlet lists may be stale at an output);
-// the sums run in a fixed order, so the result is the same for any thread count.
-VolumeCheck fluid_volume_check(const Particles& P, const CubicSpline& kernel, const Periodic& periodic);
+// lists: Verlet lists that hold every pair of P closer than the kernel's support (pairs beyond it are
+// skipped), or null: then it builds its own cell lists at the support. The sums run in a fixed order, so the
+// result is the same for any thread count.
+VolumeCheck fluid_volume_check(const Particles& P, const CubicSpline& kernel, const Periodic& periodic,
+                               const NeighborSearch* lists = nullptr);
 
 }  // namespace aortasph
