@@ -789,8 +789,9 @@ TEST_CASE("tube flow reference: a periodic tube driven by a body force carries a
   // nu = 1e-3 m^2/s), periodic along its axis and driven by a body force g instead of open boundaries. The
   // pressure-driven open tube's flow over the Poiseuille flow of its probed gradient drifts from 0.94 at
   // 0.04-0.16 s to 1.2 at 0.4 s and 1.5 at 1.2 s (stop 48); here, with the driving known exactly, the flow
-  // over pi R^4 g / (8 nu) measured 1.11-1.29 over 0.12-1.2 s with no trend (about 1.14: the SPH tube is as
-  // wide as a radius 3 % larger). Steady, and within 30 % of Poiseuille; the drift must not appear here.
+  // over pi R^4 g / (8 nu) is 1.142 (the SPH tube is as wide as a radius 3 % larger). Until stop 51 it
+  // wandered over 1.11-1.29: the fluid started with a hydrostatic density ramp along the periodic axis (3.4
+  // %, a 38 Pa jump where the ends meet; Periodic::across). Steady within 2 %, within 30 % of Poiseuille.
   json j = json::parse(R"({
     "name": "periodic_pipe",
     "domain": { "min": [-0.009, 0, -0.009], "max": [0.009, 0.016, 0.009], "periodic": ["y"] },
@@ -809,12 +810,13 @@ TEST_CASE("tube flow reference: a periodic tube driven by a body force carries a
   World w(s);
   ProbeSet probes(s, w);
   const double q_poiseuille = M_PI * std::pow(0.004, 4) * 2.5 / (8.0 * 1e-3);
-  double early = 0.0, late = 0.0;
+  double early = 0.0, late = 0.0, lo = INFINITY, hi = 0.0;
   int n_early = 0, n_late = 0;
   for (int k = 1; k <= 24; ++k) {
     w.advance_to(0.04 * k, [] { return true; });
     const double r = probes.measure(w)[0] / q_poiseuille;
     UNSCOPED_INFO("t " << w.time() << " s: flow / Poiseuille " << r);
+    if (k >= 3) lo = std::min(lo, r), hi = std::max(hi, r);
     if (k >= 3 && k <= 9) early += r, ++n_early;  // 0.12-0.36 s (the start-up's time scale R^2 / nu: 16 ms)
     if (k >= 18) late += r, ++n_late;             // 0.72-0.96 s
   }
@@ -822,4 +824,6 @@ TEST_CASE("tube flow reference: a periodic tube driven by a body force carries a
   INFO("flow / Poiseuille: " << early << " over 0.12-0.36 s, " << late << " over 0.72-0.96 s");
   CHECK(std::abs(early - 1.0) < 0.3);
   CHECK(std::abs(late / early - 1.0) < 0.1);
+  INFO("from 0.12 s: " << lo << " .. " << hi);
+  CHECK(hi / lo < 1.02);
 }

@@ -33,6 +33,14 @@ struct Periodic {
       if (on[a]) d[a] -= len[a] * std::round(d[a] / len[a]);
     return d;
   }
+  // v without its components along the periodic axes. Along a periodic axis there is no hydrostatic
+  // balance: a body force there drives a flow (plane or pipe Poiseuille) against a pressure that is the same
+  // at both faces, so the hydrostatic start and the delta-SPH's hydrostatic correction use only the rest.
+  Vec3 across(Vec3 v) const {
+    for (int a = 0; a < 3; ++a)
+      if (on[a]) v[a] = 0.0;
+    return v;
+  }
   // x moved back into [lo, lo + len) along the periodic axes.
   void wrap(Vec3& x) const {
     for (int a = 0; a < 3; ++a) {

@@ -116,9 +116,10 @@ void fluid_density_rate(Particles& P, const NeighborSearch& nb, const FluidConte
         vj += ctx.shift_rate * P.shift[j];  // zero for boundary particles
       drho += P.m[j] * dwdr_r * (vi - vj).dot(xij);
       // Density diffusion (Molteni & Colagrossi 2009, eq. 12) between particles of one fluid, minus the
-      // hydrostatic density difference rho0 g.x_ji / c0^2 (Fourtakas et al. 2019, eq. 19, linearised Tait).
+      // hydrostatic density difference rho0 g.x_ji / c0^2 (Fourtakas et al. 2019, eq. 19, linearised Tait;
+      // g without its periodic components, FluidContext::hydrostatic_gravity).
       if (diffusion > 0.0 && fluid_like(P.kind[j]) && P.material[j] == P.material[i]) {
-        const double hydro = fi.rho0 * ctx.gravity.dot(-xij) * inv_c2;  // x_j - x_i
+        const double hydro = fi.rho0 * ctx.hydrostatic_gravity.dot(-xij) * inv_c2;  // x_j - x_i
         drho -= diffusion * (P.rho[j] - rhoi - hydro) * dwdr_r * ctx.volume[j];
       }
     }

@@ -70,6 +70,9 @@ struct FluidContext {
   std::vector<double> p_over_rho2;  // p / rho^2
   std::vector<double> volume;       // m / rho
   Periodic periodic;                // periodic axes: pair separations are nearest images
+  // The part of gravity a fluid at rest balances with its pressure: gravity less its components along
+  // periodic axes (Periodic::across); the hydrostatic density difference of the density diffusion uses it.
+  Vec3 hydrostatic_gravity = Vec3::Zero();
   // Shells seen as two-sided walls (fluid/shell_wall.hpp); null when the scene has no shell beside a fluid.
   const ShellWall* shell_wall = nullptr;
   // 1 / dt of this step when the continuity equation (fluid_density_rate) takes in the particles' shifts of
