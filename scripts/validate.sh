@@ -10,7 +10,8 @@
 #      Scordelis-Lo, roll-up, plates in water), scripts/validate_taylor_green.sh (Re = 100 at lambda/20 and /40)
 #      scripts/validate_dambreak_front.sh (Martin & Moyce front at a/10 to a/30) and scripts/validate_lobovsky.sh
 #      (Lobovsky et al. 2014 wall pressure at H/20 to H/40); each takes 10-30 min; and
-#      scripts/validate_shift_packing.sh (shifting with open boundaries, about 6 min).
+#      scripts/validate_shift_packing.sh (shifting with open boundaries, about 6 min) and
+#      scripts/validate_poiseuille.sh (Poiseuille's law in periodic and open pipes, about 12 min).
 # Usage: scripts/validate.sh [--all]   (BUILD_DIR=build; builds it with scripts/build.sh when it is missing)
 # Exits non-zero when a case fails; prints each case's duration.
 set -euo pipefail
@@ -47,5 +48,6 @@ if [ "${1:-}" = --all ]; then
   scripts/validate_dambreak_front.sh "$build"
   scripts/validate_lobovsky.sh "$build"
   scripts/validate_shift_packing.sh "$build"
+  scripts/validate_poiseuille.sh "$build"
 fi
 echo "== validations passed in ${SECONDS} s"
