@@ -183,7 +183,7 @@ World::World(const Scene& scene)
     // density that the equation of state gives for it. Without this the column would first oscillate.
     // Gravity along a periodic axis drives a flow and has no hydrostatic balance (Periodic::across): until
     // stop 51 the periodic pipe of the tests started with a 3.4 % density ramp along its axis, and a jump
-    // of 38 Pa where its ends meet.
+    // of 40 Pa (rho0 g over 15 mm) where its ends meet.
     const double g = ctx_.hydrostatic_gravity.norm();
     if (mat.type == MaterialType::Fluid && g > 0.0) {
       const Vec3 up = -ctx_.hydrostatic_gravity / g;

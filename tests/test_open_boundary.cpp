@@ -791,7 +791,7 @@ TEST_CASE("tube flow reference: a periodic tube driven by a body force carries a
   // 0.04-0.16 s to 1.2 at 0.4 s and 1.5 at 1.2 s (stop 48); here, with the driving known exactly, the flow
   // over pi R^4 g / (8 nu) is 1.142 (the SPH tube is as wide as a radius 3 % larger). Until stop 51 it
   // wandered over 1.11-1.29: the fluid started with a hydrostatic density ramp along the periodic axis (3.4
-  // %, a 38 Pa jump where the ends meet; Periodic::across). Steady within 2 %, within 30 % of Poiseuille.
+  // %, a 40 Pa jump where the ends meet; Periodic::across). Steady within 2 %, within 30 % of Poiseuille.
   json j = json::parse(R"({
     "name": "periodic_pipe",
     "domain": { "min": [-0.009, 0, -0.009], "max": [0.009, 0.016, 0.009], "periodic": ["y"] },
