@@ -839,7 +839,7 @@ double World::max_density_error() const {
 
 VolumeCheck World::fluid_volume_check() const {
   // The Verlet lists when they hold every particle (none appended since the build): they cover the support.
-  const bool lists = lists_valid_ && listed_ == P_.size() && nb_.size() == P_.size();
+  const bool lists = lists_valid_ && listed_ == P_.size();
   return aortasph::fluid_volume_check(P_, kernel_, nb_.periodic(), lists ? &nb_ : nullptr);
 }
 
