@@ -285,6 +285,12 @@ World::World(const Scene& scene)
   }
   if (!solids_.empty() && contact_.k > 0.0)
     min_contact_mass_ = std::min(min_contact_mass_, solids_.min_mass());
+  // Shell contact in the shells' sub-steps (step_shells) where a fluid sets the step and no elastic body
+  // takes part in the contact. An elastic body is not sub-stepped: its contact with a sheet stays held over
+  // the step, as before stop 52. Without a fluid nothing but max_dt would bound the step (the shells' own
+  // bounds are the sub-steps'), and a sheet could leave its neighbour lists within one step: there too the
+  // contact is held and bounds the step (the [shell_contact] tests).
+  contact_in_substeps_ = shell_contact_.active() && solids_.empty() && max_c0_ > 0.0;
 
   // Spatial sort once, so neighbours sit close in memory from the first step.
   skin_ = 0.1 * kernel_.support;
@@ -313,14 +319,16 @@ double World::stable_dt() const {
   // of the solid.
   if (!solids_.empty()) dt = std::min(dt, scene_.cfl * h / (solids_.max_wave_speed() + max_speed_));
   // Shells do not bound the step: they take their own sub-steps within it (step_shells).
-  // Shell contact: the contact spring and damper of the particles near contact (ShellContact::stable_dt),
-  // from the lists (stale right after particles were created or removed: then the bound waits a step).
-  if (shell_contact_.active() && lists_valid_)
+  // Shell contact held over the shells' sub-steps (an elastic body in the scene: contact_in_substeps_
+  // false): the contact spring and damper of the particles near contact (ShellContact::stable_dt), from the
+  // lists (stale right after particles were created or removed: then the bound waits a step), and no sheet
+  // may move more than a quarter of the thinnest sheet's thickness (under the contact distance) in one
+  // step, or it could pass through a partner between two evaluations. With the contact in the sub-steps
+  // these bound the sub-steps instead (shell_stable_dt).
+  if (shell_contact_.active() && !contact_in_substeps_ && lists_valid_)
     dt = std::min(dt, shell_contact_.stable_dt(P_, nb_, shells_, ctx_.periodic, scene_.cfl));
-  // The contact forces are held over the shells' sub-steps: no sheet may move more than a quarter of the
-  // thinnest sheet's thickness (under the contact distance) in one step, or it could pass through a partner
-  // between two evaluations.
-  if (const double v = std::max(max_speed_, sub_.max_speed); shell_contact_.active() && v > 0.0)
+  if (const double v = std::max(max_speed_, sub_.max_speed);
+      shell_contact_.active() && !contact_in_substeps_ && v > 0.0)
     dt = std::min(dt, 0.25 * min_shell_thickness_ / v);
   // Viscous diffusion limit (Morris, Fox & Zhu 1997, eq. 18): dt <= 0.125 h^2 / nu.
   if (max_nu_ > 0.0) dt = std::min(dt, 0.125 * h * h / max_nu_);
@@ -559,7 +567,8 @@ void World::body_forces() {
   moment_.assign(n, Vec3::Zero());
   fluid_reaction(P_, nb_, ctx_, force_);
   contact_forces(P_, nb_, contact_, force_, moment_);
-  shell_contact_.add_forces(P_, nb_, shells_, ctx_.periodic, force_);  // sim/solid/shell_contact.hpp
+  // sim/solid/shell_contact.hpp; in the shells' sub-steps instead where no elastic body takes part
+  if (!contact_in_substeps_) shell_contact_.add_forces(P_, nb_, shells_, ctx_.periodic, force_);
   // (The fluid's barrier against a sheet acts in the shells' sub-steps: step_shells.)
 }
 
@@ -651,6 +660,7 @@ void World::step_shells(double dt) {
   if (bar)
     coupling_.barrier_begin(P_, shells_, ctx_.periodic, barrier_modulus_,
                             0.25 * scene_.spacing + 2.0 * sub_.max_speed * dt);
+  if (contact_in_substeps_) shell_contact_.gather(P_, nb_, shells_, ctx_.periodic);
   for (int k = 0; k < n; ++k) {
     const double kick = k == 0 && sub_.last_h > 0.0 ? 0.5 * (sub_.last_h + h) : h;
     if (bar) coupling_.barrier_substep(P_, shells_, ctx_.periodic, barrier_modulus_, sub_.v, h, barrier);
@@ -688,6 +698,12 @@ void World::step_shells(double dt) {
 void World::shell_substep(double h, double kick, double t, const std::vector<Vec3>& held,
                           const std::vector<Vec3>* barrier) {
   shells_.update(P_);
+  // Shell contact at the sheets' positions, directors and velocities of this sub-step (contact_in_substeps_).
+  if (contact_in_substeps_) {
+    contact_f_.resize(P_.size());
+    parallel_for(shells_.size(), [&](std::size_t s) { contact_f_[shells_.at(s)] = Vec3::Zero(); });
+    shell_contact_.add_listed_forces(P_, shells_, ctx_.periodic, contact_f_, &sub_.v);
+  }
   std::vector<double> pressure(bodies_.size(), 0.0);
   for (std::size_t b = 0; b < bodies_.size(); ++b)
     if (scene_.bodies[b].pressure_load) pressure[b] = scene_.bodies[b].pressure_load->at(t);
@@ -702,6 +718,7 @@ void World::shell_substep(double h, double kick, double t, const std::vector<Vec
     }
     Vec3 f = held[s] + shells_.internal_force(s) + pressure[P_.body[i]] * shells_.area(s) * shells_.normal(s);
     if (barrier) f += (*barrier)[s];
+    if (contact_in_substeps_) f += contact_f_[i];
     P_.a[i] = f / shells_.mass(s) + gravity_ - shells_.damping(s) * v;
     if (shells_.support(s) >= 3) {  // a diaphragm (validations): held in the plane across free_axis
       const Vec3& ax = shells_.free_axis(s);
@@ -717,6 +734,18 @@ void World::shell_substep(double h, double kick, double t, const std::vector<Vec
 
 double World::shell_stable_dt() const {
   double dt = shells_.stable_dt(scene_.cfl, sub_.max_speed);
+  // Shell contact in the sub-steps (contact_in_substeps_): its spring, damper and closing time
+  // (ShellContact::stable_dt) at the sheets' sub-step velocities bound the sub-step, not the fluid's step,
+  // and no sheet moves more than a quarter of the thinnest sheet's thickness in one sub-step (the contact is
+  // evaluated once per sub-step). Issue 18 item 3: the contact's bound applies to the contacting particles
+  // only. (In the physio scene it had set the fluid's step: 6.0-6.5 us against the acoustic 7.1 us, stops
+  // 46-47.)
+  if (contact_in_substeps_) {
+    if (lists_valid_ && nb_.size() == P_.size())
+      dt = std::min(dt, shell_contact_.stable_dt(P_, nb_, shells_, ctx_.periodic, scene_.cfl,
+                                                 sub_.v.size() == shells_.size() ? &sub_.v : nullptr));
+    if (sub_.max_speed > 0.0) dt = std::min(dt, 0.25 * min_shell_thickness_ / sub_.max_speed);
+  }
   // Force limit (Monaghan 1992) on the shells' own accelerations.
   if (sub_.max_accel > 0.0) dt = std::min(dt, 0.25 * std::sqrt(kernel_.h / sub_.max_accel));
   return dt;

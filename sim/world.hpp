@@ -241,6 +241,8 @@ class World {
   OpenBoundaries open_;  // inflows and outflows; their counters are plain values (OpenBoundaryState)
   ContactParams contact_;
   double min_shell_thickness_ = std::numeric_limits<double>::max();  // the step bound under shell contact
+  bool contact_in_substeps_ = false;  // shell contact evaluated in the shells' sub-steps (World::step_shells)
+  std::vector<Vec3> contact_f_;       // its forces in a sub-step, by particle (shell entries only)
   ShellContact shell_contact_;  // sheets against sheets and walls (active when contact.shell_stiffness > 0)
   double min_contact_mass_ = std::numeric_limits<double>::max();
   std::vector<Vec3> force_;   // per-particle force on body particles of the current step

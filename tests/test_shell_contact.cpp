@@ -125,6 +125,86 @@ TEST_CASE("shell contact: two plates pressed together rest at the contact distan
   CHECK(std::abs(f.x()) + std::abs(f.y()) < 1e-3 * load);
 }
 
+TEST_CASE(
+    "shell contact: in the shells' sub-steps (a fluid sets the step) the plates rest at the same gap and "
+    "the contact no longer bounds the step",
+    "[shell_contact]") {
+  // The two plates above with a fluid material in the scene (no fluid particles: its sound speed alone sets
+  // the step through the acoustic CFL, cfl h / c0 = 65 us at c0 = 10 m/s). The contact is then evaluated in
+  // every shell sub-step (World::shell_substep, stop 52) and its spring and dashpot bound the sub-steps, not
+  // the step. Measure: the interior gap at 4 ms against the barrier law, the smallest gap over the run, the
+  // steps against the held contact's bound at the end, and the listed pairs (ShellContact::gather) against
+  // add_forces on the same state.
+  Scene s = base_scene();
+  s.materials = {sheet_material(kDamp), water(10.0)};
+  const double a = 10 * kDx;
+  s.bodies = {plate("lower", 0, Vec3(0, 0, -0.5e-3), a, a, Vec3::UnitZ()),
+              plate("upper", 0, Vec3(0, 0, 0.5e-3), a, a, -Vec3::UnitZ())};
+  s.bodies[0].pressure_load = TimeSeries{{}, {kP}};
+  s.bodies[1].pressure_load = TimeSeries{{}, {kP}};
+  World w(s);
+  const Particles& P = w.particles();
+  std::vector<std::size_t> up(P.size(), 0);
+  for (std::size_t i = 0; i < P.size(); ++i)
+    for (std::size_t j = 0; j < P.size(); ++j)
+      if (P.body[i] == 0 && P.body[j] == 1 && (P.x0[i] - P.x0[j]).head<2>().norm() < 1e-9) up[i] = j;
+  double min_gap = 1.0, dt_min = 1.0;
+  int steps = 0;
+  run(w, 0.004, [&] {
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (P.body[i] == 0) min_gap = std::min(min_gap, P.x[up[i]].z() - P.x[i].z());
+    dt_min = std::min(dt_min, w.last_dt());
+    ++steps;
+  });
+  const double dc = 1.5 * kT, rest = dc * kK / (kK + kP);
+  double interior = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (P.body[i] == 0 && std::abs(P.x0[i].x()) < 3e-3 && std::abs(P.x0[i].y()) < 3e-3) {
+      interior += P.x[up[i]].z() - P.x[i].z();
+      ++n;
+    }
+  interior /= n;
+  ShellContact c({s.contact.shell_stiffness, s.contact.shell_margin, s.contact.shell_damping, s.spacing},
+                 w.kernel().support);
+  const double held_bound = c.stable_dt(P, w.neighbors(), w.shells(), Periodic(), s.cfl);
+  INFO(steps << " steps, smallest dt " << dt_min << ", the held contact's bound now " << held_bound
+             << ", shell sub-steps in the last step " << w.last_shell_substeps() << "; gap interior "
+             << interior << " (barrier law " << rest << "), min over run " << min_gap);
+  CHECK(min_gap > 0.5 * dc);
+  CHECK(interior == Approx(rest).epsilon(0.02));
+  CHECK(dt_min > 3.0 * held_bound);  // the acoustic step (49.7 us), 4.6x the held contact's bound
+  CHECK(w.last_shell_substeps() > 5);
+  // The listed pairs give add_forces' forces, bit for bit (the same pairs in the same order), on the free
+  // shell particles.
+  std::vector<Vec3> all(P.size(), Vec3::Zero()), listed(P.size(), Vec3::Zero());
+  c.add_forces(P, w.neighbors(), w.shells(), Periodic(), all);
+  c.gather(P, w.neighbors(), w.shells(), Periodic());
+  c.add_listed_forces(P, w.shells(), Periodic(), listed, nullptr);
+  int compared = 0;
+  double largest = 0.0;
+  for (std::size_t q = 0; q < w.shells().size(); ++q) {
+    const std::size_t i = w.shells().at(q);
+    CHECK(listed[i] == all[i]);
+    largest = std::max(largest, all[i].norm());
+    ++compared;
+  }
+  CHECK(compared == static_cast<int>(w.shells().size()));
+  CHECK(largest > 0.0);
+  // 1 and 2 threads: the same positions, bit for bit, after 2 ms (the plates reach the contact distance
+  // within 0.2 ms: 10 kPa on 0.4 kg/m2).
+  const int before = max_threads();
+  std::vector<Vec3> x[2];
+  for (int k = 0; k < 2; ++k) {
+    set_threads(k + 1);
+    World t(s);
+    run(t, 0.002, [] {});
+    x[k] = t.particles().x;
+  }
+  set_threads(before);
+  CHECK(x[0] == x[1]);
+}
+
 TEST_CASE("shell contact: a plate pressed on a fixed wall rests above it", "[shell_contact][heavy]") {
   Scene s = base_scene();
   s.materials = {sheet_material(3000.0), wall()};

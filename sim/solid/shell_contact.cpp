@@ -36,7 +36,7 @@ bool ShellContact::candidate(const Particles& P, const Shells& sh, std::size_t i
 // The pair (a, b), xab = x_a - x_b: force on a (b takes its negative), and the pair's stiffness, damper and
 // closing time near contact.
 ShellContact::Pair ShellContact::pair(const Particles& P, const Shells& sh, std::size_t a, std::size_t b,
-                                      const Vec3& xab) const {
+                                      const Vec3& xab, const Vec3& vab) const {
   Pair out;
   out.gap = kInf;
   const double dx = p_.dx;
@@ -132,7 +132,6 @@ ShellContact::Pair ShellContact::pair(const Particles& P, const Shells& sh, std:
     const double p = std::max(K * (dc / ge - 1.0) - ca * rate, 0.0);  // barrier + damper, never pulling
     return (p * w) * e;
   };
-  const Vec3 vab = P.v[a] - P.v[b];
   if (b_shell && share_b > 0.0) {  // a on b's plane
     weight = share_b;
     out.f_a += term(sb, xab, vab);
@@ -146,8 +145,13 @@ ShellContact::Pair ShellContact::pair(const Particles& P, const Shells& sh, std:
 
 template <class Visit>
 void ShellContact::visit_row(const Particles& P, const NeighborSearch& nb, const Shells& sh,
-                             const Periodic& per, std::size_t i, Visit&& visit) const {
+                             const Periodic& per, std::size_t i, const std::vector<Vec3>* shell_v,
+                             Visit&& visit) const {
   const auto& idx = nb.index();
+  const auto velocity = [&](std::size_t q) -> const Vec3& {
+    if (shell_v && P.kind[q] == Kind::Shell) return (*shell_v)[static_cast<std::size_t>(sh.slot(q))];
+    return P.v[q];
+  };
   // The full row: the shell coupling may have cut masked fluid pairs off the end (NeighborSearch::end).
   for (uint32_t k = nb.begin(i); k < nb.full_end(i); ++k) {
     const uint32_t j = idx[k];
@@ -156,21 +160,22 @@ void ShellContact::visit_row(const Particles& P, const NeighborSearch& nb, const
     if (xij.squaredNorm() >= 9.0 * p_.dx * p_.dx) continue;
     // One order for every pair (the lower id first), so the two particles see exactly opposite forces.
     if (P.id[i] < P.id[j]) {
-      visit(pair(P, sh, i, j, xij), 1.0);
+      visit(pair(P, sh, i, j, xij, Vec3(velocity(i) - velocity(j))), 1.0);
     } else {
       const Vec3 xji = per.any ? per.image(P.x[j] - P.x[i]) : Vec3(P.x[j] - P.x[i]);
-      visit(pair(P, sh, j, i, xji), -1.0);
+      visit(pair(P, sh, j, i, xji, Vec3(velocity(j) - velocity(i))), -1.0);
     }
   }
 }
 
 void ShellContact::add_forces(const Particles& P, const NeighborSearch& nb, const Shells& sh,
-                              const Periodic& per, std::vector<Vec3>& f) const {
+                              const Periodic& per, std::vector<Vec3>& f,
+                              const std::vector<Vec3>* shell_v) const {
   if (!active() || sh.empty() || nb.size() != P.size()) return;
   parallel_for_dynamic(P.size(), [&](std::size_t i) {
     if (P.kind[i] != Kind::Shell && P.kind[i] != Kind::Elastic) return;  // walls do not move
     Vec3 sum = Vec3::Zero();
-    visit_row(P, nb, sh, per, i, [&](const Pair& pr, double sign) {
+    visit_row(P, nb, sh, per, i, shell_v, [&](const Pair& pr, double sign) {
       if (sign > 0.0)
         sum += pr.f_a;
       else
@@ -180,8 +185,57 @@ void ShellContact::add_forces(const Particles& P, const NeighborSearch& nb, cons
   });
 }
 
+void ShellContact::gather(const Particles& P, const NeighborSearch& nb, const Shells& sh,
+                          const Periodic& per) {
+  listed_row_.clear();
+  listed_offset_.assign(1, 0);
+  listed_.clear();
+  if (!active() || sh.empty() || nb.size() != P.size()) return;
+  for (std::size_t s = 0; s < sh.size(); ++s)
+    if (sh.support(s) != 1 && sh.support(s) != 2) listed_row_.push_back(sh.at(s));
+  std::vector<std::vector<uint32_t>> rows(listed_row_.size());
+  const auto& idx = nb.index();
+  parallel_for(listed_row_.size(), [&](std::size_t r) {
+    const uint32_t i = listed_row_[r];
+    for (uint32_t k = nb.begin(i); k < nb.full_end(i); ++k) {
+      const uint32_t j = idx[k];
+      if (!candidate(P, sh, i, j)) continue;
+      const Vec3 xij = per.any ? per.image(P.x[i] - P.x[j]) : Vec3(P.x[i] - P.x[j]);
+      if (xij.squaredNorm() < 9.0 * p_.dx * p_.dx) rows[r].push_back(j);
+    }
+  });
+  for (const auto& row : rows) {
+    listed_.insert(listed_.end(), row.begin(), row.end());
+    listed_offset_.push_back(static_cast<uint32_t>(listed_.size()));
+  }
+}
+
+void ShellContact::add_listed_forces(const Particles& P, const Shells& sh, const Periodic& per,
+                                     std::vector<Vec3>& f, const std::vector<Vec3>* shell_v) const {
+  const auto velocity = [&](std::size_t q) -> const Vec3& {
+    if (shell_v && P.kind[q] == Kind::Shell) return (*shell_v)[static_cast<std::size_t>(sh.slot(q))];
+    return P.v[q];
+  };
+  parallel_for_dynamic(listed_row_.size(), [&](std::size_t r) {
+    const uint32_t i = listed_row_[r];
+    Vec3 sum = Vec3::Zero();
+    for (uint32_t k = listed_offset_[r]; k < listed_offset_[r + 1]; ++k) {
+      const uint32_t j = listed_[k];
+      // As visit_row: one order for every pair (the lower id first), the other particle its exact negative.
+      if (P.id[i] < P.id[j]) {
+        const Vec3 xij = per.any ? per.image(P.x[i] - P.x[j]) : Vec3(P.x[i] - P.x[j]);
+        sum += pair(P, sh, i, j, xij, Vec3(velocity(i) - velocity(j))).f_a;
+      } else {
+        const Vec3 xji = per.any ? per.image(P.x[j] - P.x[i]) : Vec3(P.x[j] - P.x[i]);
+        sum -= pair(P, sh, j, i, xji, Vec3(velocity(j) - velocity(i))).f_a;
+      }
+    }
+    f[i] += sum;
+  });
+}
+
 double ShellContact::stable_dt(const Particles& P, const NeighborSearch& nb, const Shells& sh,
-                               const Periodic& per, double cfl) const {
+                               const Periodic& per, double cfl, const std::vector<Vec3>* shell_v) const {
   if (!active() || sh.empty() || nb.size() != P.size()) return kInf;
   return parallel_reduce(
       sh.size(), kInf,
@@ -190,7 +244,7 @@ double ShellContact::stable_dt(const Particles& P, const NeighborSearch& nb, con
         const std::size_t i = sh.at(s);
         double k = 0.0, c = 0.0, close = kInf;
         bool near = false;
-        visit_row(P, nb, sh, per, i, [&](const Pair& pr, double) {
+        visit_row(P, nb, sh, per, i, shell_v, [&](const Pair& pr, double) {
           if (!pr.near) return;
           near = true;
           k += pr.k;
@@ -214,7 +268,8 @@ double ShellContact::min_gap(const Particles& P, const NeighborSearch& nb, const
       sh.size(), kInf,
       [&](std::size_t s) {
         double g = kInf;
-        visit_row(P, nb, sh, per, sh.at(s), [&](const Pair& pr, double) { g = std::min(g, pr.gap); });
+        visit_row(P, nb, sh, per, sh.at(s), nullptr,
+                  [&](const Pair& pr, double) { g = std::min(g, pr.gap); });
         return g;
       },
       [](double x, double y) { return std::min(x, y); });

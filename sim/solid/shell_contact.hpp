@@ -59,14 +59,25 @@ class ShellContact {
   bool active() const { return p_.stiffness > 0.0; }
   const ShellContactParams& params() const { return p_; }
 
-  // Adds the contact forces to f (indexed like P) on every shell and elastic particle.
+  // Adds the contact forces to f (indexed like P) on every shell and elastic particle. shell_v: the shells'
+  // velocities by slot (their sub-step velocities, World::step_shells), or null: P.v.
   void add_forces(const Particles& P, const NeighborSearch& nb, const Shells& sh, const Periodic& per,
-                  std::vector<Vec3>& f) const;
+                  std::vector<Vec3>& f, const std::vector<Vec3>* shell_v = nullptr) const;
+  // The contact in sub-steps (World::step_shells): gather() lists, once per step from the neighbour lists,
+  // each free shell particle's candidate partners (as add_forces would visit them); add_listed_forces()
+  // then adds the contact forces on those particles at the current positions and directors and the
+  // velocities shell_v (by slot), visiting only the listed pairs. Held particles (clamped, pinned) get no
+  // row: they do not move. The pairs are those within 3 dx at the gather; the sheets move by under a third
+  // of a spacing in a step (the fluid's CFL counts their speed), and a pair acts within 2.4 dx.
+  void gather(const Particles& P, const NeighborSearch& nb, const Shells& sh, const Periodic& per);
+  void add_listed_forces(const Particles& P, const Shells& sh, const Periodic& per, std::vector<Vec3>& f,
+                         const std::vector<Vec3>* shell_v) const;
+
   // Largest stable step of the contacting shell particles (those within twice the contact distance of a
   // partner): cfl sqrt(2 m / k) for the contact spring of stiffness k (both sides moving), cfl 2 m / c for
   // the damper, and a quarter of the gap over its closing speed. Infinity when no particle is near contact.
   double stable_dt(const Particles& P, const NeighborSearch& nb, const Shells& sh, const Periodic& per,
-                   double cfl) const;
+                   double cfl, const std::vector<Vec3>* shell_v = nullptr) const;
 
   // Diagnostics: the smallest gap s between a shell particle and a partner's plane within a patch, over
   // the pairs the lists hold (infinity if none).
@@ -80,14 +91,17 @@ class ShellContact {
     double gap = 0.0;         // smallest plane gap of the pair within a patch (infinity: none)
     bool near = false;
   };
-  Pair pair(const Particles& P, const Shells& sh, std::size_t a, std::size_t b, const Vec3& xab) const;
+  // vab = v_a - v_b.
+  Pair pair(const Particles& P, const Shells& sh, std::size_t a, std::size_t b, const Vec3& xab,
+            const Vec3& vab) const;
   bool candidate(const Particles& P, const Shells& sh, std::size_t i, std::size_t j) const;
   template <class Visit>
   void visit_row(const Particles& P, const NeighborSearch& nb, const Shells& sh, const Periodic& per,
-                 std::size_t i, Visit&& visit) const;
+                 std::size_t i, const std::vector<Vec3>* shell_v, Visit&& visit) const;
 
   ShellContactParams p_;
   double cutoff_ = 0.0;
+  std::vector<uint32_t> listed_row_, listed_offset_, listed_;  // gather(): rows (particle), CSR of partners
 };
 
 }  // namespace aortasph
