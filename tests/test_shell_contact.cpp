@@ -67,6 +67,40 @@ Vec3 contact_on(const World& w, int b, Vec3* total = nullptr, double* magnitude 
   return sum;
 }
 
+// Two free 10 x 10 mm plates (t = 0.4 mm, dx = 1 mm), 1 mm apart, pressed together by 10 kPa each.
+Scene pressed_plates() {
+  Scene s = base_scene();
+  s.materials = {sheet_material(kDamp)};
+  const double a = 10 * kDx;
+  s.bodies = {plate("lower", 0, Vec3(0, 0, -0.5e-3), a, a, Vec3::UnitZ()),
+              plate("upper", 0, Vec3(0, 0, 0.5e-3), a, a, -Vec3::UnitZ())};
+  s.bodies[0].pressure_load = TimeSeries{{}, {kP}};
+  s.bodies[1].pressure_load = TimeSeries{{}, {kP}};
+  return s;
+}
+
+// For each particle of the lower plate (body 0), its partner on the upper one: the same lattice, one above
+// the other.
+std::vector<std::size_t> partners_above(const Particles& P) {
+  std::vector<std::size_t> up(P.size(), 0);
+  for (std::size_t i = 0; i < P.size(); ++i)
+    for (std::size_t j = 0; j < P.size(); ++j)
+      if (P.body[i] == 0 && P.body[j] == 1 && (P.x0[i] - P.x0[j]).head<2>().norm() < 1e-9) up[i] = j;
+  return up;
+}
+
+// The mean gap between the plates over the lower plate's particles within 3 mm of the centre.
+double interior_gap(const Particles& P, const std::vector<std::size_t>& up) {
+  double interior = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < P.size(); ++i)
+    if (P.body[i] == 0 && std::abs(P.x0[i].x()) < 3e-3 && std::abs(P.x0[i].y()) < 3e-3) {
+      interior += P.x[up[i]].z() - P.x[i].z();
+      ++n;
+    }
+  return interior / n;
+}
+
 void run(World& w, double t_end, const std::function<void()>& each) {
   w.advance_to(t_end, [&] {
     each();
@@ -78,21 +112,11 @@ void run(World& w, double t_end, const std::function<void()>& each) {
 
 TEST_CASE("shell contact: two plates pressed together rest at the contact distance and carry the load",
           "[shell_contact][heavy]") {
-  // Two free 10 x 10 mm plates (t = 0.4 mm, dx = 1 mm), 1 mm apart, pressed together by 10 kPa each.
-  Scene s = base_scene();
-  s.materials = {sheet_material(kDamp)};
-  const double a = 10 * kDx;
-  s.bodies = {plate("lower", 0, Vec3(0, 0, -0.5e-3), a, a, Vec3::UnitZ()),
-              plate("upper", 0, Vec3(0, 0, 0.5e-3), a, a, -Vec3::UnitZ())};
-  s.bodies[0].pressure_load = TimeSeries{{}, {kP}};
-  s.bodies[1].pressure_load = TimeSeries{{}, {kP}};
-  World w(s);
+  // The pressed plates (pressed_plates above); no fluid material: the contact is held and bounds the step.
+  World w(pressed_plates());
   const Particles& P = w.particles();
-  // Partners: the same lattice, one above the other.
-  std::vector<std::size_t> up(P.size(), 0);
-  for (std::size_t i = 0; i < P.size(); ++i)
-    for (std::size_t j = 0; j < P.size(); ++j)
-      if (P.body[i] == 0 && P.body[j] == 1 && (P.x0[i] - P.x0[j]).head<2>().norm() < 1e-9) up[i] = j;
+  const std::vector<std::size_t> up = partners_above(P);
+  const double a = 10 * kDx;
   double min_gap = 1.0;
   const auto gaps = [&] {
     for (std::size_t i = 0; i < P.size(); ++i)
@@ -106,14 +130,7 @@ TEST_CASE("shell contact: two plates pressed together rest at the contact distan
     dt_min = std::min(dt_min, w.last_dt());
   });
   const double dc = 1.5 * kT, rest = dc * kK / (kK + kP);
-  double interior = 0.0;
-  int n = 0;
-  for (std::size_t i = 0; i < P.size(); ++i)
-    if (P.body[i] == 0 && std::abs(P.x0[i].x()) < 3e-3 && std::abs(P.x0[i].y()) < 3e-3) {
-      interior += P.x[up[i]].z() - P.x[i].z();
-      ++n;
-    }
-  interior /= n;
+  const double interior = interior_gap(P, up);
   const Vec3 f = contact_on(w, 0);
   const double load = kP * a * a;
   INFO(steps << " steps, smallest dt " << dt_min << "; gap interior " << interior << " (barrier law " << rest
@@ -135,19 +152,11 @@ TEST_CASE(
   // the step. Measure: the interior gap at 4 ms against the barrier law, the smallest gap over the run, the
   // steps against the held contact's bound at the end, and the listed pairs (ShellContact::gather) against
   // add_forces on the same state.
-  Scene s = base_scene();
-  s.materials = {sheet_material(kDamp), water(10.0)};
-  const double a = 10 * kDx;
-  s.bodies = {plate("lower", 0, Vec3(0, 0, -0.5e-3), a, a, Vec3::UnitZ()),
-              plate("upper", 0, Vec3(0, 0, 0.5e-3), a, a, -Vec3::UnitZ())};
-  s.bodies[0].pressure_load = TimeSeries{{}, {kP}};
-  s.bodies[1].pressure_load = TimeSeries{{}, {kP}};
+  Scene s = pressed_plates();
+  s.materials.push_back(water(10.0));
   World w(s);
   const Particles& P = w.particles();
-  std::vector<std::size_t> up(P.size(), 0);
-  for (std::size_t i = 0; i < P.size(); ++i)
-    for (std::size_t j = 0; j < P.size(); ++j)
-      if (P.body[i] == 0 && P.body[j] == 1 && (P.x0[i] - P.x0[j]).head<2>().norm() < 1e-9) up[i] = j;
+  const std::vector<std::size_t> up = partners_above(P);
   double min_gap = 1.0, dt_min = 1.0;
   int steps = 0;
   run(w, 0.004, [&] {
@@ -157,14 +166,7 @@ TEST_CASE(
     ++steps;
   });
   const double dc = 1.5 * kT, rest = dc * kK / (kK + kP);
-  double interior = 0.0;
-  int n = 0;
-  for (std::size_t i = 0; i < P.size(); ++i)
-    if (P.body[i] == 0 && std::abs(P.x0[i].x()) < 3e-3 && std::abs(P.x0[i].y()) < 3e-3) {
-      interior += P.x[up[i]].z() - P.x[i].z();
-      ++n;
-    }
-  interior /= n;
+  const double interior = interior_gap(P, up);
   ShellContact c({s.contact.shell_stiffness, s.contact.shell_margin, s.contact.shell_damping, s.spacing},
                  w.kernel().support);
   const double held_bound = c.stable_dt(P, w.neighbors(), w.shells(), Periodic(), s.cfl);
