@@ -67,8 +67,9 @@ class ShellContact {
   // each free shell particle's candidate partners (as add_forces would visit them); add_listed_forces()
   // then adds the contact forces on those particles at the current positions and directors and the
   // velocities shell_v (by slot), visiting only the listed pairs. Held particles (clamped, pinned) get no
-  // row: they do not move. The pairs are those within 3 dx at the gather; the sheets move by under a third
-  // of a spacing in a step (the fluid's CFL counts their speed), and a pair acts within 2.4 dx.
+  // row: they do not move. The pairs are those the lists hold within 3 dx at the gather; in a step a sheet
+  // moves by at most cfl h |v| / (c0 + |v|) (the fluid's CFL counts its speed: 0.03 dx at 2 m/s in the
+  // physio scene), and a pair acts within 2.4 dx.
   void gather(const Particles& P, const NeighborSearch& nb, const Shells& sh, const Periodic& per);
   void add_listed_forces(const Particles& P, const Shells& sh, const Periodic& per, std::vector<Vec3>& f,
                          const std::vector<Vec3>* shell_v) const;
