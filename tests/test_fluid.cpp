@@ -238,6 +238,29 @@ TEST_CASE("dam break surge front follows Martin & Moyce", "[fluid][validation]")
   CHECK(compared >= 8);
 }
 
+namespace {
+
+// A periodic box's 10^3 fluid particles on a lattice of spacing s, each of mass rho0 dx^3 and density rho0,
+// particle (i, j, k) at ((i, j, k) + 1/2) s plus offset() (drawn per coordinate, x then y then z).
+template <class Offset>
+Particles fluid_lattice(double s, double dx, double rho0, Offset&& offset) {
+  Particles P;
+  P.resize(1000);
+  std::size_t n = 0;
+  for (int k = 0; k < 10; ++k)
+    for (int j = 0; j < 10; ++j)
+      for (int i = 0; i < 10; ++i, ++n) {
+        const double x = (i + 0.5) * s + offset(), y = (j + 0.5) * s + offset(), z = (k + 0.5) * s + offset();
+        P.x[n] = Vec3(x, y, z);
+        P.kind[n] = Kind::Fluid;
+        P.m[n] = rho0 * dx * dx * dx;
+        P.rho[n] = rho0;
+      }
+  return P;
+}
+
+}  // namespace
+
 TEST_CASE("the volume check reads the kernel's lattice sum on a lattice and sees particles that stand apart",
           "[fluid][diagnostics]") {
   // fluid/volume_check.hpp: sum_j m_j W_ij / rho_i over the fluid whose support holds only fluid. A periodic
@@ -256,17 +279,7 @@ TEST_CASE("the volume check reads the kernel's lattice sum on a lattice and sees
   };
   for (const double stretch : {1.0, 1.04}) {
     const double s = stretch * dx, len = 10 * s;
-    Particles P;
-    P.resize(1000);
-    std::size_t n = 0;
-    for (int k = 0; k < 10; ++k)
-      for (int j = 0; j < 10; ++j)
-        for (int i = 0; i < 10; ++i, ++n) {
-          P.x[n] = Vec3((i + 0.5) * s, (j + 0.5) * s, (k + 0.5) * s);
-          P.kind[n] = Kind::Fluid;
-          P.m[n] = rho0 * dx * dx * dx;
-          P.rho[n] = rho0;
-        }
+    Particles P = fluid_lattice(s, dx, rho0, [] { return 0.0; });
     const Periodic per({Vec3::Zero(), Vec3::Constant(len)}, {true, true, true});
     const VolumeCheck c = fluid_volume_check(P, K, per);
     INFO("stretch " << stretch << ": mean " << c.mean << ", lattice sum " << lattice_sum(s));
@@ -314,18 +327,7 @@ TEST_CASE(
   auto shaken = [&](double a) {
     std::mt19937 gen(52);
     auto u = [&] { return (static_cast<double>(gen()) / 4294967296.0 * 2.0 - 1.0) * a; };
-    Particles P;
-    P.resize(1000);
-    std::size_t n = 0;
-    for (int k = 0; k < 10; ++k)
-      for (int j = 0; j < 10; ++j)
-        for (int i = 0; i < 10; ++i, ++n) {
-          P.x[n] = Vec3((i + 0.5) * dx + u(), (j + 0.5) * dx + u(), (k + 0.5) * dx + u());
-          P.kind[n] = Kind::Fluid;
-          P.m[n] = rho0 * dx * dx * dx;
-          P.rho[n] = rho0;
-        }
-    return fluid_volume_check(P, K, per);
+    return fluid_volume_check(fluid_lattice(dx, dx, rho0, u), K, per);
   };
   const VolumeCheck still = shaken(0.0), light = shaken(0.087 * dx), strong = shaken(0.26 * dx);
   INFO("lattice " << still.mean << ", a = 0.087 dx: " << light.mean << ", a = 0.26 dx: " << strong.mean);

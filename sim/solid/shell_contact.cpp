@@ -143,28 +143,32 @@ ShellContact::Pair ShellContact::pair(const Particles& P, const Shells& sh, std:
   return out;
 }
 
+ShellContact::Oriented ShellContact::oriented(const Particles& P, const Shells& sh, const Periodic& per,
+                                              std::size_t i, std::size_t j, const Vec3& xij,
+                                              const std::vector<Vec3>* shell_v) const {
+  const auto velocity = [&](std::size_t q) -> const Vec3& {
+    if (shell_v && P.kind[q] == Kind::Shell) return (*shell_v)[static_cast<std::size_t>(sh.slot(q))];
+    return P.v[q];
+  };
+  // One order for every pair (the lower id first), so the two particles see exactly opposite forces.
+  if (P.id[i] < P.id[j]) return {pair(P, sh, i, j, xij, Vec3(velocity(i) - velocity(j))), 1.0};
+  const Vec3 xji = per.any ? per.image(P.x[j] - P.x[i]) : Vec3(P.x[j] - P.x[i]);
+  return {pair(P, sh, j, i, xji, Vec3(velocity(j) - velocity(i))), -1.0};
+}
+
 template <class Visit>
 void ShellContact::visit_row(const Particles& P, const NeighborSearch& nb, const Shells& sh,
                              const Periodic& per, std::size_t i, const std::vector<Vec3>* shell_v,
                              Visit&& visit) const {
   const auto& idx = nb.index();
-  const auto velocity = [&](std::size_t q) -> const Vec3& {
-    if (shell_v && P.kind[q] == Kind::Shell) return (*shell_v)[static_cast<std::size_t>(sh.slot(q))];
-    return P.v[q];
-  };
   // The full row: the shell coupling may have cut masked fluid pairs off the end (NeighborSearch::end).
   for (uint32_t k = nb.begin(i); k < nb.full_end(i); ++k) {
     const uint32_t j = idx[k];
     if (!candidate(P, sh, i, j)) continue;
     const Vec3 xij = per.any ? per.image(P.x[i] - P.x[j]) : Vec3(P.x[i] - P.x[j]);
     if (xij.squaredNorm() >= 9.0 * p_.dx * p_.dx) continue;
-    // One order for every pair (the lower id first), so the two particles see exactly opposite forces.
-    if (P.id[i] < P.id[j]) {
-      visit(pair(P, sh, i, j, xij, Vec3(velocity(i) - velocity(j))), 1.0);
-    } else {
-      const Vec3 xji = per.any ? per.image(P.x[j] - P.x[i]) : Vec3(P.x[j] - P.x[i]);
-      visit(pair(P, sh, j, i, xji, Vec3(velocity(j) - velocity(i))), -1.0);
-    }
+    const Oriented o = oriented(P, sh, per, i, j, xij, shell_v);
+    visit(o.pair, o.sign);
   }
 }
 
@@ -212,23 +216,17 @@ void ShellContact::gather(const Particles& P, const NeighborSearch& nb, const Sh
 
 void ShellContact::add_listed_forces(const Particles& P, const Shells& sh, const Periodic& per,
                                      std::vector<Vec3>& f, const std::vector<Vec3>* shell_v) const {
-  const auto velocity = [&](std::size_t q) -> const Vec3& {
-    if (shell_v && P.kind[q] == Kind::Shell) return (*shell_v)[static_cast<std::size_t>(sh.slot(q))];
-    return P.v[q];
-  };
   parallel_for_dynamic(listed_row_.size(), [&](std::size_t r) {
     const uint32_t i = listed_row_[r];
     Vec3 sum = Vec3::Zero();
     for (uint32_t k = listed_offset_[r]; k < listed_offset_[r + 1]; ++k) {
       const uint32_t j = listed_[k];
-      // As visit_row: one order for every pair (the lower id first), the other particle its exact negative.
-      if (P.id[i] < P.id[j]) {
-        const Vec3 xij = per.any ? per.image(P.x[i] - P.x[j]) : Vec3(P.x[i] - P.x[j]);
-        sum += pair(P, sh, i, j, xij, Vec3(velocity(i) - velocity(j))).f_a;
-      } else {
-        const Vec3 xji = per.any ? per.image(P.x[j] - P.x[i]) : Vec3(P.x[j] - P.x[i]);
-        sum -= pair(P, sh, j, i, xji, Vec3(velocity(j) - velocity(i))).f_a;
-      }
+      const Vec3 xij = per.any ? per.image(P.x[i] - P.x[j]) : Vec3(P.x[i] - P.x[j]);
+      const Oriented o = oriented(P, sh, per, i, j, xij, shell_v);
+      if (o.sign > 0.0)
+        sum += o.pair.f_a;
+      else
+        sum -= o.pair.f_a;
     }
     f[i] += sum;
   });

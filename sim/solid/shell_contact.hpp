@@ -96,6 +96,14 @@ class ShellContact {
   Pair pair(const Particles& P, const Shells& sh, std::size_t a, std::size_t b, const Vec3& xab,
             const Vec3& vab) const;
   bool candidate(const Particles& P, const Shells& sh, std::size_t i, std::size_t j) const;
+  // The pair (i, j), x_ij = x_i - x_j, evaluated in one order for every pair (the lower id first) with the
+  // velocities shell_v (by slot) for shells, or P.v; sign +1 when the force is on i, -1 when on j.
+  struct Oriented {
+    Pair pair;
+    double sign;
+  };
+  Oriented oriented(const Particles& P, const Shells& sh, const Periodic& per, std::size_t i, std::size_t j,
+                    const Vec3& xij, const std::vector<Vec3>* shell_v) const;
   template <class Visit>
   void visit_row(const Particles& P, const NeighborSearch& nb, const Shells& sh, const Periodic& per,
                  std::size_t i, const std::vector<Vec3>* shell_v, Visit&& visit) const;
