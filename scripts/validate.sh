@@ -11,7 +11,8 @@
 #      scripts/validate_dambreak_front.sh (Martin & Moyce front at a/10 to a/30) and scripts/validate_lobovsky.sh
 #      (Lobovsky et al. 2014 wall pressure at H/20 to H/40); each takes 10-30 min; and
 #      scripts/validate_shift_packing.sh (shifting with open boundaries, about 6 min) and
-#      scripts/validate_poiseuille.sh (Poiseuille's law in periodic and open pipes, about 12 min).
+#      scripts/validate_poiseuille.sh (Poiseuille's law in periodic and open pipes, about 12 min) and
+#      scripts/validate_diastole.sh (the closed valve under a diastolic load for 0.1 s, about 9 min).
 # Usage: scripts/validate.sh [--all]   (BUILD_DIR=build; builds it with scripts/build.sh when it is missing)
 # Exits non-zero when a case fails; prints each case's duration.
 set -euo pipefail
@@ -49,5 +50,6 @@ if [ "${1:-}" = --all ]; then
   scripts/validate_lobovsky.sh "$build"
   scripts/validate_shift_packing.sh "$build"
   scripts/validate_poiseuille.sh "$build"
+  scripts/validate_diastole.sh "$build"
 fi
 echo "== validations passed in ${SECONDS} s"
