@@ -105,8 +105,8 @@ def main():
           f"{probes['balance.aorta.flow'][w].mean() * 1e6:+.1f} ml/s")
     print(f"  aorta probe less Windkessel: mean {gap.mean():+.1f} mmHg (last 10 ms {gap[-10:].mean():+.1f})")
     if inside:
-        last = max(k for k in inside if k <= a.t1 + 1e-9)
-        print(f"  fluid particles inside a wall: at most {max(inside.values())} (last frame {inside[last]})")
+        seen = {k: v for k, v in inside.items() if k <= a.t1 + 1e-9}
+        print(f"  fluid particles inside a wall: at most {max(seen.values())} (last frame {seen[max(seen)]})")
 
 
 if __name__ == "__main__":
