@@ -17,7 +17,6 @@ particles inside a wall.
 usage: scripts/diastole.py RUN_DIR [--from T] [--to T]   (numpy; Debian's python3-numpy)
 """
 import argparse
-import csv
 import os
 import sys
 
@@ -33,11 +32,9 @@ MMHG = 133.322
 
 
 def table(path):
-    with open(path) as f:
-        rows = list(csv.reader(f))
-    head = rows[0]
+    rows = study_report.read_csv_rows(path)
     data = np.array([[float(v) for v in r] for r in rows[1:] if r])
-    return {k: data[:, i] for i, k in enumerate(head)}
+    return {k: data[:, i] for i, k in enumerate(rows[0])}
 
 
 def walls_inside(run_dir, scene):
@@ -47,22 +44,12 @@ def walls_inside(run_dir, scene):
     fluid = vtk_run.bodies_of_type(scene, "fluid")
     walls = vtk_run.bodies_of_type(scene, "wall")
     out = {}
-    pvd = os.path.join(run_dir, "vtk", "particles.pvd")
-    times = {}
-    if os.path.exists(pvd):
-        with open(pvd) as f:
-            for line in f:
-                if "timestep=" in line and "file=" in line:
-                    t = float(line.split('timestep="')[1].split('"')[0])
-                    times[line.split('file="')[1].split('"')[0]] = t
-    for frame in vtk_run.frames(run_dir):
-        if frame not in times:
-            continue
-        d = {k: np.asarray(v) for k, v in study_report.read_vtp(os.path.join(run_dir, "vtk", frame)).items()}
+    for t, path in vtk_run.frame_times(run_dir):
+        d = {k: np.asarray(v) for k, v in study_report.read_vtp(path).items()}
         body = d["body"].astype(np.int64)
         fl = np.isin(body, fluid)
         frac = wall_leak.wall_fraction(d["Points"][fl], d["Points"][np.isin(body, walls)], dx, h)
-        out[round(times[frame], 6)] = int((frac > 0.8).sum())
+        out[round(t, 6)] = int((frac > 0.8).sum())
     return out
 
 

@@ -22,28 +22,18 @@ import csv
 import json
 import math
 import os
-import re
 import sys
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 import study_report  # noqa: E402 (same folder: its .vtp reader)
+import vtk_run  # noqa: E402
 
 
 def read_vtp(path):
     """study_report.py's reader of the ascii .vtp files, as numpy arrays ('Points' is the positions)."""
     return {name: np.asarray(values, dtype=float) for name, values in study_report.read_vtp(path).items()}
-
-
-def frames(run_dir):
-    pvd = os.path.join(run_dir, 'vtk', 'particles.pvd')
-    if not os.path.exists(pvd):
-        sys.exit(f'{pvd}: not found (run with --vtk or --vtk-every N)')
-    out = []
-    for m in re.finditer(r'timestep="([^"]+)"[^>]*file="([^"]+)"', open(pvd).read()):
-        out.append((float(m.group(1)), os.path.join(run_dir, 'vtk', m.group(2))))
-    return out
 
 
 def cubic_w(q):
@@ -106,7 +96,7 @@ def plot_sections(args):
     wide.radius, wide.ymin, wide.ymax = 1.0, -1.0, 1.0
     fig, axes = plt.subplots(len(runs), 3, figsize=(12, 5.0 * len(runs)), squeeze=False)
     for row, (label, run_dir) in enumerate(runs):
-        fr = frames(run_dir)[-2:]
+        fr = vtk_run.frame_times(run_dir)[-2:]
         for col in range(3):
             t, path = fr[min(col, len(fr) - 1)]
             x, speed, res = noise(read_vtp(path), wide, want_fields=True)
@@ -174,7 +164,7 @@ def main():
             sys.exit(f'{spec}: expected LABEL=RUN_DIR')
         label, run_dir = spec.split('=', 1)
         result[label] = []
-        for t, path in frames(run_dir):
+        for t, path in vtk_run.frame_times(run_dir):
             r = noise(read_vtp(path), args)
             if r is None:
                 continue

@@ -1,8 +1,9 @@
-"""What the VTK readers of a run's particles share (scripts/wall_leak.py, scripts/packing.py): the run's scene,
-its bodies by material type, its frames, and the candidate pairs of particles in neighbouring cells.
+"""What the VTK readers of a run's particles share (scripts/wall_leak.py, scripts/packing.py, scripts/diastole.py, scripts/jet_noise.py): the run's scene,
+its bodies by material type, its frames and their times, and the candidate pairs of particles in neighbouring cells.
 Needs numpy only."""
 import json
 import os
+import re
 import sys
 
 import numpy as np
@@ -33,6 +34,17 @@ def frames(run_dir):
     if not found:
         sys.exit(f"{vtk}: no particles_*.vtp (run with --vtk)")
     return found
+
+
+def frame_times(run_dir):
+    """(time, path) of each frame that RUN_DIR/vtk/particles.pvd lists, in its order; exits if it is missing."""
+    pvd = os.path.join(run_dir, "vtk", "particles.pvd")
+    if not os.path.exists(pvd):
+        sys.exit(f"{pvd}: not found (run with --vtk or --vtk-every N)")
+    with open(pvd) as f:
+        text = f.read()
+    return [(float(m.group(1)), os.path.join(run_dir, "vtk", m.group(2)))
+            for m in re.finditer(r'timestep="([^"]+)"[^>]*file="([^"]+)"', text)]
 
 
 def cell_pairs(xq, xs, side):
