@@ -439,6 +439,7 @@ class Loader {
                 "background_pressure",
                 "shifting",
                 "shifting_ale",
+                "mask_density",
                 "transport_velocity"};
       else if (type == "elastic")
         keys = {"type",  "density", "youngs_modulus", "poisson_ratio", "hourglass", "artificial_viscosity",
@@ -469,6 +470,7 @@ class Loader {
         m.shifting = o.non_negative("shifting", 0.0);
         if (m.shifting > 10.0) fail(o.path("shifting"), "must lie in 0..10 (Skillen et al. 2013 use 1..6)");
         m.shifting_ale = o.boolean("shifting_ale", false);
+        m.mask_density = o.boolean("mask_density", false);
         if (o.has("transport_velocity")) {  // Adami et al. 2013 (sim/fluid/transport_velocity.hpp)
           Obj tv(o.raw("transport_velocity"), o.path("transport_velocity"), {"background_pressure"}, allowed);
           m.transport_velocity_pb = tv.positive("background_pressure");

@@ -52,6 +52,9 @@ struct Material {
   // correction, sim/fluid/shifting.hpp); off by default (the physio scene with it on stopped at 79 ms, stop
   // 44).
   bool shifting_ale = false;
+  // Beside shells: the density follows the summation density across the changes of the masks that keep the
+  // two sides of a sheet apart (sim/boundary/mask_density.hpp); off by default (stop 54).
+  bool mask_density = false;
   // Transport-velocity formulation (sim/fluid/transport_velocity.hpp): its background pressure p_b [Pa],
   // which drives the advection velocity only (unlike background_pressure above); 0 switches it off.
   double transport_velocity_pb = 0.0;

@@ -104,6 +104,7 @@ World::World(const Scene& scene)
     max_nu_ = std::max(max_nu_, mat.viscosity);
     shifting_ = shifting_ || mat.shifting > 0.0;
     transport_ = transport_ || mat.transport_velocity_pb > 0.0;
+    mask_density_on_ = mask_density_on_ || fluid_[m].mask_density;
   }
   if (!have_fluid) wall_ref_ = FluidParams(Material{});
 
@@ -441,6 +442,12 @@ void World::step(double dt) {
   // Shells between fluids: pairs across a sheet masked, imaginary wall particles placed (timed as boundary).
   if (coupling_.active()) {
     coupling_.prepare(P_, shells_, nb_, ctx.periodic);
+    // The densities across this step's changes of the masks (boundary/mask_density.hpp).
+    if (mask_density_on_)
+      mask_density_.apply(
+          P_, nb_, coupling_.wall(), kernel_, ctx.periodic,
+          [&](std::size_t i) { return coupling_.in_band(i); },
+          [&](std::size_t i) { return fluid_[P_.material[i]].mask_density; });
     profile_.boundary += seconds_since(t0);
     t0 = Clock::now();
   }
@@ -954,6 +961,12 @@ void World::save_state(StateWriter& out) const {
       SectionWriter& sd = out.section("shell_label_disagreements", 1);
       sd.value(coupling_.label_disagreements());
     }
+    if (mask_density_on_) {  // the last step's masks (boundary/mask_density.hpp)
+      SectionWriter& sm = out.section("shell_masks", 1);
+      sm.array(mask_density_.ids());
+      sm.array(mask_density_.offsets());
+      sm.array(mask_density_.rows());
+    }
   }
 
   SectionWriter& nb = out.section("neighbors", 1);
@@ -1097,6 +1110,19 @@ void World::load_state(const StateReader& in) {
     SectionReader sd = in.section("shell_label_disagreements");
     coupling_.set_label_disagreements(sd.value<long>());
     sd.done();
+  }
+  mask_density_ = MaskDensity{};  // without the section: the first step counts no change of the masks
+  if (in.has("shell_masks")) {
+    SectionReader sm = in.section("shell_masks");
+    std::vector<uint32_t> ids, offsets, rows;
+    sm.array(ids, "shell mask ids");
+    sm.array(offsets, "shell mask offsets", ids.size() + 1);
+    sm.array(rows, "shell mask rows", offsets.empty() ? 0 : offsets.back());
+    sm.done();
+    if (offsets[0] != 0) sm.mismatch("shell mask offsets", offsets[0], 0);
+    for (std::size_t r = 0; r < ids.size(); ++r)
+      if (offsets[r] > offsets[r + 1]) sm.mismatch("shell mask offsets", offsets[r], offsets[r + 1]);
+    mask_density_.restore(std::move(ids), std::move(offsets), std::move(rows));
   }
 
   // The solid's reference configuration is rebuilt from the scene (it never changes); only its map from

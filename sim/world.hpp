@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "boundary/mask_density.hpp"
 #include "boundary/open_boundary.hpp"
 #include "boundary/shell_coupling.hpp"
 #include "core/kernel.hpp"
@@ -227,6 +228,8 @@ class World {
   Solids solids_;
   Shells shells_;
   ShellSheets sheets_;                   // the shells' triangulated mid-surfaces (render, VTK)
+  MaskDensity mask_density_;             // the density across the coupling's mask changes
+  bool mask_density_on_ = false;         // a fluid material asks for it (FluidParams::mask_density)
   ShellCoupling coupling_;               // active when a scene has shells and a fluid
   std::vector<double> barrier_modulus_;  // per material, the fluid's barrier K [Pa]; empty: off
   // Shell sub-cycling state (step_shells): leapfrog velocities by shell slot (empty until the first step,

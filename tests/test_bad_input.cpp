@@ -93,6 +93,10 @@ TEST_CASE("bad input: malformed scenes and arguments exit 2 naming the problem",
       {"shifting_ale not a boolean",
        replace(good, "\"sound_speed\": 10 }", "\"sound_speed\": 10, \"shifting\": 2, \"shifting_ale\": 1 }"),
        "", "materials.water.shifting_ale: expected"},
+      // Whether the masks' changes beside shells enter the density (materials.<fluid>.mask_density).
+      {"mask_density not a boolean",
+       replace(good, "\"sound_speed\": 10 }", "\"sound_speed\": 10, \"mask_density\": \"yes\" }"), "",
+       "materials.water.mask_density: expected"},
       // A fluid body's jitter (bodies[].jitter, issue 20).
       {"jitter too large",
        replace(good, "\"velocity\": [0, 0, 0],", "\"velocity\": [0, 0, 0], \"jitter\": 0.3,"), "",

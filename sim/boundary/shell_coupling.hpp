@@ -99,6 +99,8 @@ class ShellCoupling {
   void barrier_end(Particles& P, double dt) const;
 
   const ShellWall& wall() const { return wall_; }
+  // Whether particle i's row can hold masks: a shell particle in its full row at the last list build.
+  bool in_band(std::size_t i) const { return i < band_of_.size() && band_of_[i] >= 0; }
 
   // The side (+1 / -1) on which the last prepare() labelled particle i with respect to shell body `body`
   // (0: no label).

@@ -34,6 +34,7 @@ struct FluidParams {
   double p_background = 0.0;
   double shifting = 0.0;      // particle shifting coefficient A (fluid/shifting.hpp)
   bool shifting_ale = false;  // the shift enters the density (fluid/shifting.hpp)
+  bool mask_density = false;  // the masks' changes enter the density (boundary/mask_density.hpp)
   double tv_pb = 0.0;         // transport-velocity background pressure p_b (fluid/transport_velocity.hpp)
   bool summation = false;
 
@@ -50,6 +51,7 @@ struct FluidParams {
         p_background(m.background_pressure),
         shifting(m.shifting),
         shifting_ale(m.shifting > 0.0 && m.shifting_ale && !m.density_summation),
+        mask_density(m.mask_density && !m.density_summation),
         tv_pb(m.transport_velocity_pb),
         summation(m.density_summation) {}
   FluidParams() = default;
