@@ -18,8 +18,10 @@
 //     stand for). Shell-shell and solid-solid pairs are never masked (contact needs them). This is the
 //     "side masking" of /work/shared/reference/shell.md section 4, which SPHinXsys's one-sided coupling
 //     lacks. The masked pairs move to the tail of their rows (NeighborSearch::set_end): every loop of the
-//     step skips them, and the rows are restored from the lists' build before each step, so the result does
-//     not depend on the history of the masks (checkpoints restart bitwise).
+//     step skips them, and the rows are restored from the lists' build before each step, so the masks do
+//     not depend on their own history (checkpoints restart bitwise). A fluid material with `mask_density`
+//     has its density follow the summation density across each step's changes of the masks
+//     (boundary/mask_density.hpp, which keeps the last step's masks and saves them in checkpoints).
 //  3. Guard. After the drift, a fluid particle near a sheet is checked against the sheet as a surface: the
 //     triangles through its particles (solid/shell_mesh.hpp) at their current positions, with a skirt dx / 2
 //     wide along every edge (where the sheet's patches end). The closest point c of that surface near the
