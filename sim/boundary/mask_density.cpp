@@ -46,13 +46,48 @@ double MaskDensity::apply_to(Particles& P, const NeighborSearch& nb, const Shell
     }
     jump[r] = d;
   });
+  // Spread over the fluid round each particle (see the header): source j gives V_j drho_j W_ij / S_j to
+  // each fluid particle i in its row (itself included), S_j = sum_k V_k W_jk over the same particles, so
+  // that the volume change sum V drho is what the masks made. Gathered: each receiver sums its sources.
+  const std::size_t n = P.size();
+  std::vector<double> share(n, 0.0);  // V_j drho_j / S_j of each source
+  std::vector<uint8_t> receives(n, 0);
+  for (std::size_t r = 0; r < order.size(); ++r) {
+    if (jump[r] == 0.0) continue;
+    const uint32_t j = order[r];
+    double S = P.m[j] / P.rho[j] * K.W(0.0);
+    for (uint32_t k = nb.begin(j); k < nb.end(j); ++k) {
+      const uint32_t q = idx[k];
+      if (P.kind[q] != Kind::Fluid) continue;
+      const Vec3 x = per.any ? per.image(P.x[j] - P.x[q]) : Vec3(P.x[j] - P.x[q]);
+      S += P.m[q] / P.rho[q] * K.W(x.norm());
+      receives[q] = 1;
+    }
+    share[j] = P.m[j] / P.rho[j] * jump[r] / S;
+    receives[j] = 1;
+  }
+  std::vector<double> gain(n, 0.0);
+  parallel_for(n, [&](std::size_t i) {
+    if (!receives[i]) return;
+    double g = share[i] * K.W(0.0);
+    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
+      const uint32_t j = idx[k];
+      if (share[j] == 0.0) continue;
+      const Vec3 x = per.any ? per.image(P.x[i] - P.x[j]) : Vec3(P.x[i] - P.x[j]);
+      g += share[j] * K.W(x.norm());
+    }
+    gain[i] = g;
+  });
   double total = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!receives[i]) continue;
+    P.rho[i] += gain[i];
+    total += gain[i];
+  }
   ids_.clear();
   offset_.assign(1, 0);
   row_.clear();
   for (std::size_t r = 0; r < order.size(); ++r) {
-    P.rho[order[r]] += jump[r];
-    total += jump[r];
     if (take[order[r]] != 2) continue;
     ids_.push_back(P.id[order[r]]);
     row_.insert(row_.end(), row.begin() + off[r], row.begin() + off[r + 1]);
