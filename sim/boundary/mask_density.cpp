@@ -51,9 +51,8 @@ double MaskDensity::apply_to(Particles& P, const NeighborSearch& nb, const Shell
   // that the volume change sum V drho is what the masks made. Gathered: each receiver sums its sources.
   const std::size_t n = P.size();
   std::vector<double> share(n, 0.0);  // V_j drho_j / S_j of each source
-  std::vector<uint8_t> receives(n, 0);
-  for (std::size_t r = 0; r < order.size(); ++r) {
-    if (jump[r] == 0.0) continue;
+  parallel_for(order.size(), [&](std::size_t r) {
+    if (jump[r] == 0.0) return;
     const uint32_t j = order[r];
     double S = P.m[j] / P.rho[j] * K.W(0.0);
     for (uint32_t k = nb.begin(j); k < nb.end(j); ++k) {
@@ -61,14 +60,12 @@ double MaskDensity::apply_to(Particles& P, const NeighborSearch& nb, const Shell
       if (P.kind[q] != Kind::Fluid) continue;
       const Vec3 x = per.any ? per.image(P.x[j] - P.x[q]) : Vec3(P.x[j] - P.x[q]);
       S += P.m[q] / P.rho[q] * K.W(x.norm());
-      receives[q] = 1;
     }
     share[j] = P.m[j] / P.rho[j] * jump[r] / S;
-    receives[j] = 1;
-  }
+  });
   std::vector<double> gain(n, 0.0);
   parallel_for(n, [&](std::size_t i) {
-    if (!receives[i]) return;
+    if (P.kind[i] != Kind::Fluid) return;
     double g = share[i] * K.W(0.0);
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
@@ -80,7 +77,6 @@ double MaskDensity::apply_to(Particles& P, const NeighborSearch& nb, const Shell
   });
   double total = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (!receives[i]) continue;
     P.rho[i] += gain[i];
     total += gain[i];
   }
