@@ -5,7 +5,8 @@
 # Windkessel outlet starts at 80 mmHg; cfl 0.5, probes every 1 ms, VTK every 10 ms; then scripts/diastole.py
 # (particle growth, flows through the annulus and the aortic outlet, the aorta's pressure against the
 # Windkessel's, blood inside the walls). About 9 min on the quiet 2-core machine. Further arguments go to
-# `aortasph run` (e.g. --set materials.blood.shifting=0) to compare a variant with the shipped scene.
+# `aortasph run` (e.g. --set materials.blood.shifting=0) to compare a variant with the shipped scene; stop 54's
+# steady diastole: --set materials.blood.mask_density=true --set materials.blood.shifting_ale=true --end-time 0.2.
 # Usage: scripts/validate_diastole.sh [BUILD_DIR] [OUT_DIR] [run arguments...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
