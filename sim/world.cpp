@@ -445,8 +445,7 @@ void World::step(double dt) {
     // The densities across this step's changes of the masks (boundary/mask_density.hpp).
     if (mask_density_on_)
       mask_density_.apply(
-          P_, nb_, coupling_.wall(), kernel_, ctx.periodic,
-          [&](std::size_t i) { return coupling_.in_band(i); },
+          P_, nb_, ctx, [&](std::size_t i) { return coupling_.in_band(i); },
           [&](std::size_t i) { return fluid_[P_.material[i]].mask_density; });
     profile_.boundary += seconds_since(t0);
     t0 = Clock::now();

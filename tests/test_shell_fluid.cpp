@@ -776,7 +776,6 @@ double band_summation_ratio(const World& w) {
   const Particles& P = w.particles();
   const NeighborSearch& nb = w.neighbors();
   const FluidContext& ctx = w.fluid_context();
-  const ShellWall& sw = *ctx.shell_wall;
   const auto& idx = nb.index();
   double sum = 0.0;
   std::size_t n = 0;
@@ -786,14 +785,8 @@ double band_summation_ratio(const World& w) {
     double s = P.m[i] * ctx.kernel.W(0.0);
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
-      const Vec3 xij = P.x[i] - P.x[j];
-      if (P.kind[j] == Kind::Shell) {
-        near = true;
-        sw.for_each_ghost(xij, i, j, P.body[j],
-                          [&](const Vec3& rg) { s += sw.ghost_mass[j] * ctx.kernel.W(rg.norm()); });
-      } else {
-        s += P.m[j] * ctx.kernel.W(xij.norm());
-      }
+      near = near || P.kind[j] == Kind::Shell;
+      s += summation_term(P, ctx, i, j, ctx.separation(P.x[i], P.x[j]));
     }
     if (!near) continue;
     sum += s / P.rho[i];

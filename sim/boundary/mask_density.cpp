@@ -6,9 +6,10 @@
 
 namespace aortasph {
 
-double MaskDensity::apply_to(Particles& P, const NeighborSearch& nb, const ShellWall& sw,
-                             const CubicSpline& K, const Periodic& per, const std::vector<uint8_t>& take) {
+void MaskDensity::apply_to(Particles& P, const NeighborSearch& nb, const FluidContext& ctx,
+                           const std::vector<uint8_t>& take) {
   const auto& idx = nb.index();
+  const CubicSpline& K = ctx.kernel;
   std::vector<uint32_t> order;
   for (std::size_t i = 0; i < P.size(); ++i)
     if (take[i]) order.push_back(static_cast<uint32_t>(i));
@@ -35,13 +36,8 @@ double MaskDensity::apply_to(Particles& P, const NeighborSearch& nb, const Shell
       if (it == e || (*it >> 1) != P.id[j]) continue;  // outside the support at the last step
       const bool seen_before = (*it & 1u) == 0u, seen_now = k < seen_end;
       if (seen_before == seen_now) continue;
-      const Vec3 xij = per.any ? per.image(P.x[i] - P.x[j]) : Vec3(P.x[i] - P.x[j]);
-      double c = 0.0;
-      if (P.kind[j] == Kind::Shell)  // its imaginary particles on i's side of the sheet now
-        sw.for_each_ghost(xij, i, j, P.body[j],
-                          [&](const Vec3& rg) { c += sw.ghost_mass[j] * K.W(rg.norm()); });
-      else
-        c = P.m[j] * K.W(xij.norm());
+      const double c =
+          summation_term(P, ctx, i, j, ctx.separation(P.x[i], P.x[j]));  // a sheet: on i's side now
       d += seen_now ? c : -c;
     }
     jump[r] = d;
@@ -49,6 +45,8 @@ double MaskDensity::apply_to(Particles& P, const NeighborSearch& nb, const Shell
   // Spread over the fluid round each particle (see the header): source j gives V_j drho_j W_ij / S_j to
   // each fluid particle i in its row (itself included), S_j = sum_k V_k W_jk over the same particles, so
   // that the volume change sum V drho is what the masks made. Gathered: each receiver sums its sources.
+  // Only the sources' rows receive; they are marked one source at a time (a few hundred sources per step in
+  // the physio scene), then gathered in parallel.
   const std::size_t n = P.size();
   std::vector<double> share(n, 0.0);  // V_j drho_j / S_j of each source
   parallel_for(order.size(), [&](std::size_t r) {
@@ -57,29 +55,35 @@ double MaskDensity::apply_to(Particles& P, const NeighborSearch& nb, const Shell
     double S = P.m[j] / P.rho[j] * K.W(0.0);
     for (uint32_t k = nb.begin(j); k < nb.end(j); ++k) {
       const uint32_t q = idx[k];
-      if (P.kind[q] != Kind::Fluid) continue;
-      const Vec3 x = per.any ? per.image(P.x[j] - P.x[q]) : Vec3(P.x[j] - P.x[q]);
-      S += P.m[q] / P.rho[q] * K.W(x.norm());
+      if (P.kind[q] == Kind::Fluid) S += P.m[q] / P.rho[q] * K.W(ctx.separation(P.x[j], P.x[q]).norm());
     }
     share[j] = P.m[j] / P.rho[j] * jump[r] / S;
   });
-  std::vector<double> gain(n, 0.0);
-  parallel_for(n, [&](std::size_t i) {
-    if (P.kind[i] != Kind::Fluid) return;
+  std::vector<uint32_t> receivers;
+  std::vector<uint8_t> marked(n, 0);
+  for (std::size_t r = 0; r < order.size(); ++r) {
+    if (jump[r] == 0.0) continue;
+    const uint32_t j = order[r];
+    auto mark = [&](uint32_t q) {
+      if (P.kind[q] == Kind::Fluid && !marked[q]) {
+        marked[q] = 1;
+        receivers.push_back(q);
+      }
+    };
+    mark(j);
+    for (uint32_t k = nb.begin(j); k < nb.end(j); ++k) mark(idx[k]);
+  }
+  std::vector<double> gain(receivers.size(), 0.0);
+  parallel_for(receivers.size(), [&](std::size_t r) {
+    const uint32_t i = receivers[r];
     double g = share[i] * K.W(0.0);
     for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
       const uint32_t j = idx[k];
-      if (share[j] == 0.0) continue;
-      const Vec3 x = per.any ? per.image(P.x[i] - P.x[j]) : Vec3(P.x[i] - P.x[j]);
-      g += share[j] * K.W(x.norm());
+      if (share[j] != 0.0) g += share[j] * K.W(ctx.separation(P.x[i], P.x[j]).norm());
     }
-    gain[i] = g;
+    gain[r] = g;
   });
-  double total = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    P.rho[i] += gain[i];
-    total += gain[i];
-  }
+  for (std::size_t r = 0; r < receivers.size(); ++r) P.rho[receivers[r]] += gain[r];
   ids_.clear();
   offset_.assign(1, 0);
   row_.clear();
@@ -90,7 +94,6 @@ double MaskDensity::apply_to(Particles& P, const NeighborSearch& nb, const Shell
     offset_.push_back(static_cast<uint32_t>(row_.size()));
   }
   index_ids();
-  return total;
 }
 
 void MaskDensity::restore(std::vector<uint32_t> ids, std::vector<uint32_t> offsets,

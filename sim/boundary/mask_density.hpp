@@ -37,24 +37,21 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/kernel.hpp"
 #include "core/neighbors.hpp"
 #include "core/particles.hpp"
-#include "core/periodic.hpp"
-#include "fluid/shell_wall.hpp"
+#include "fluid/fluid_wcsph.hpp"
 
 namespace aortasph {
 
 class MaskDensity {
  public:
-  // After this step's masks (ShellCoupling::prepare): adds each fluid particle's delta rho (above) to
-  // P.rho and records the masks now. in_band(i): whether particle i's row can hold masks (a shell particle
-  // in its full row); the rows of the particles recorded at the last step are compared as well. Returns
-  // the sum of the density changes (a diagnostic).
-  // wanted(i): whether fluid particle i's material asks for it (FluidParams::mask_density).
+  // After this step's masks (ShellCoupling::prepare, which set ctx.shell_wall): adds each fluid particle's
+  // delta rho (above) to P.rho and records the masks now. in_band(i): whether particle i's row can hold
+  // masks (a shell particle in its full row); the rows of the particles recorded at the last step are
+  // compared as well. wanted(i): whether fluid particle i's material asks for it (FluidParams::mask_density).
   template <class InBand, class Wanted>
-  double apply(Particles& P, const NeighborSearch& nb, const ShellWall& sw, const CubicSpline& K,
-               const Periodic& per, InBand&& in_band, Wanted&& wanted) {
+  void apply(Particles& P, const NeighborSearch& nb, const FluidContext& ctx, InBand&& in_band,
+             Wanted&& wanted) {
     std::vector<uint8_t> take(P.size(), 0);  // 1: compare with the record, 2: also record now
     for (std::size_t i = 0; i < P.size(); ++i) {
       if (P.kind[i] != Kind::Fluid || !wanted(i)) continue;
@@ -63,7 +60,7 @@ class MaskDensity {
       else if (recorded(P.id[i]))
         take[i] = 1;  // left the band at this build: its row has no masks now, nor at the next step
     }
-    return apply_to(P, nb, sw, K, per, take);
+    apply_to(P, nb, ctx, take);
   }
 
   // The record, for checkpoints: by recorded particle, its id, and its row's neighbours as built (ids, each
@@ -74,8 +71,8 @@ class MaskDensity {
   void restore(std::vector<uint32_t> ids, std::vector<uint32_t> offsets, std::vector<uint32_t> rows);
 
  private:
-  double apply_to(Particles& P, const NeighborSearch& nb, const ShellWall& sw, const CubicSpline& K,
-                  const Periodic& per, const std::vector<uint8_t>& take);
+  void apply_to(Particles& P, const NeighborSearch& nb, const FluidContext& ctx,
+                const std::vector<uint8_t>& take);
   bool recorded(uint32_t id) const { return id < record_of_.size() && record_of_[id] >= 0; }
   void index_ids();
 

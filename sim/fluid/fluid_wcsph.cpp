@@ -61,6 +61,16 @@ void fluid_density_summation(Particles& P, const NeighborSearch& nb, const Fluid
   });
 }
 
+double summation_term(const Particles& P, const FluidContext& ctx, std::size_t i, uint32_t j,
+                      const Vec3& xij) {
+  if (ctx.shell_wall && P.kind[j] == Kind::Shell) {
+    double sum = 0.0;
+    shell_density(P, ctx, i, j, xij, sum);
+    return sum;
+  }
+  return P.m[j] * ctx.kernel.W(xij.norm());
+}
+
 void fluid_pressure(Particles& P, const FluidContext& ctx) {
   parallel_for(P.size(), [&](std::size_t i) {
     if (P.kind[i] == Kind::Fluid) P.p[i] = ctx.params[P.material[i]].pressure(P.rho[i]);

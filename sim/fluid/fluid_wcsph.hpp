@@ -107,6 +107,10 @@ void fluid_pair_terms(const Particles& P, FluidContext& ctx);
 
 // Density by summation, eq. (11), for fluid particles whose material asks for it.
 void fluid_density_summation(Particles& P, const NeighborSearch& nb, const FluidContext& ctx);
+// Neighbour j's term of eq. (11) for fluid particle i, x_ij = x_i - x_j: m_j W_ij, or for a shell particle
+// its imaginary wall particles' sum_g m_g W_ig on i's side of the sheet (fluid/shell_wall.hpp).
+double summation_term(const Particles& P, const FluidContext& ctx, std::size_t i, uint32_t j,
+                      const Vec3& xij);
 
 // Pressure from density, eq. (13), for every fluid particle.
 void fluid_pressure(Particles& P, const FluidContext& ctx);
