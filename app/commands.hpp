@@ -26,6 +26,7 @@ struct ResumeOptions {
   std::filesystem::path dir;
   int threads = 0;
   bool quiet = false;
+  std::optional<double> end_time;  // --end-time: run on to a new end (extends a finished run)
 };
 
 int cmd_run(const RunOptions& options);

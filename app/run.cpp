@@ -327,6 +327,10 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   ProbeSet probes(scene, world);  // resolved on the state at t = 0, as in the run that wrote the checkpoint
   check_cycle_columns(scene, probes.columns());
   if (resume) world.load_state(*resume);
+  if (resume && world.time() > scene.t_end * (1.0 + 1e-12))
+    throw InputError(dir.string() + ": the checkpoint is at t = " + format_number(world.time()) +
+                     " s, past the end " + format_number(scene.t_end) +
+                     " s (resume --end-time T with T later)");
   std::optional<CsvWriter> probe_csv, diag_csv;
   std::optional<VtkWriter> vtk;
   if (resume) {
@@ -595,6 +599,10 @@ ResumeOptions parse_resume_options(const std::vector<std::string>& args) {
       if (o.threads < 1 || o.threads > 1024) throw InputError("--threads: expected 1..1024, got " + args[k]);
     } else if (a == "--quiet") {
       o.quiet = true;
+    } else if (a == "--end-time") {
+      if (k + 1 >= args.size()) throw InputError(a + ": missing value");
+      o.end_time = parse_double(a, args[++k]);
+      if (*o.end_time <= 0) throw InputError("--end-time: must be positive, got " + args[k]);
     } else if (!a.empty() && a[0] == '-') {
       throw InputError(a + ": unknown option for resume (see aortasph --help)");
     } else if (!have_dir) {
@@ -656,6 +664,11 @@ int cmd_resume(const ResumeOptions& ro) {
   o.quiet = ro.quiet;
   if (record.checkpoint_every > 0.0) o.checkpoint_every = record.checkpoint_every;
   if (record.end_override > 0.0) o.end_time = record.end_override;
+  if (ro.end_time) {  // a new end, after the hash check (the recorded scene is the one that was run)
+    loaded.scene.t_end = *ro.end_time;
+    loaded.resolved["time"]["end"] = *ro.end_time;
+    o.end_time = ro.end_time;
+  }
   try {
     return execute(std::move(loaded), o, ro.dir, record.file_end, &state, &record);
   } catch (const SetupError& e) {

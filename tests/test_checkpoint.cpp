@@ -392,6 +392,30 @@ TEST_CASE("checkpoint: resume refuses another version, another scene, no checkpo
   CHECK(err.find("no checkpoint") != std::string::npos);
 }
 
+TEST_CASE("checkpoint: resume --end-time runs a finished run on to a later end, as one run would",
+          "[checkpoint][cli]") {
+  const fs::path scene = scene_file();
+  const Outputs& ref = reference(scene);  // the scene's own end, 0.06
+  const fs::path out = scratch("extended");
+  std::string err;
+  REQUIRE(run_cli("run " + scene.string() + " --quiet --end-time 0.04 --checkpoint-every 0.02 --out " +
+                      out.string(),
+                  &err) == 0);
+  const std::string short_probes = slurp(out / "probes.csv");
+  CHECK(std::count(short_probes.begin(), short_probes.end(), '\n') == 12);  // header + t = 0 .. 0.04
+  // An end before the checkpoint's time is refused, and leaves the run as it was.
+  CHECK(run_cli("resume " + out.string() + " --quiet --end-time 0.03", &err) == 2);
+  CHECK(err.find("past the end") != std::string::npos);
+  CHECK(slurp(out / "probes.csv") == short_probes);
+  CHECK(run_cli("resume " + out.string() + " --quiet --end-time -1", &err) == 2);
+  CHECK(err.find("--end-time") != std::string::npos);
+  const int code = run_cli("resume " + out.string() + " --quiet --end-time 0.06", &err);
+  INFO(err);
+  REQUIRE(code == 0);
+  check_same(outputs_of(out), ref);  // probes, every frame and the figure whose t = 0.06 lay beyond 0.04
+  CHECK(slurp(out / "run.json").find("\"end\": 0.06") != std::string::npos);
+}
+
 TEST_CASE("checkpoint: resume keeps --end-time (figure times beyond it) and --vtk-every",
           "[checkpoint][cli]") {
   const fs::path scene = scene_file();
