@@ -9,7 +9,8 @@
 # scenes 33 s, on a loaded machine; at stop 34 six 1-vs-2-thread comparisons, 48 s of shard time, which
 # ThreadSanitizer and the Release step check, and the light-sheet barrier case, 16 s; at stop 45 the
 # deep-buffer list audit, 30 s, the pressure inlet beside an off-lattice wall, 26 s, the soft blocks' contact,
-# 15 s, and the barrier beside a free edge's plane, 13 s, CI having taken 936 s),
+# 15 s, and the barrier beside a free edge's plane, 13 s, CI having taken 936 s; at stop 55 the resume to a
+# later end, 13 s),
 # each while other cases cover its code under the sanitizers; they all run in the Release step), a
 # ThreadSanitizer build runs the simulation-render pipeline test, a bounded libFuzzer run
 # fuzzes the scene loader (scripts/fuzz.sh, built in the same clang sanitizer tree), then the Release build (GCC)

@@ -393,7 +393,7 @@ TEST_CASE("checkpoint: resume refuses another version, another scene, no checkpo
 }
 
 TEST_CASE("checkpoint: resume --end-time runs a finished run on to a later end, as one run would",
-          "[checkpoint][cli]") {
+          "[checkpoint][cli][heavy]") {
   const fs::path scene = scene_file();
   const Outputs& ref = reference(scene);  // the scene's own end, 0.06
   const fs::path out = scratch("extended");
