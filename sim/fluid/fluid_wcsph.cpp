@@ -286,9 +286,11 @@ struct PairShift {
   const double rhoj = P.rho[j];
   const bool fluid_j = fluid_like(P.kind[j]);  // open-boundary buffer particles count as fluid
   // ctx.volume[j] is m_j / rho_j of this very step (fluid_pair_terms runs just before the forces).
-  if (shift)
+  if (shift) {
     shift->sums.add_gradient(xij, gradW, ctx.kernel.W(r) / shift->w_dx, ctx.volume[j],
                              fluid_j ? -1 : int32_t(P.body[j]));
+    if (P.kind[j] == Kind::Inflow) shift->sums.beside_inflow = true;
+  }
   const Vec3 vij = I.v - P.v[j];
 
   // Pressure, eq. (9) with the 1/rho_i of Algorithm 1 line 9 applied: a_i = -sum m_j (p_i/rho_i^2 +
