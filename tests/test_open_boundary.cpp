@@ -829,7 +829,7 @@ TEST_CASE("tube flow reference: a periodic tube driven by a body force carries a
   CHECK(hi / lo < 1.02);
 }
 
-TEST_CASE("shifting_ale: blood beside an inflow buffer does not shift; without shifting_ale it does",
+TEST_CASE("shifting_ale: blood beside an inflow buffer does not shift, without shifting_ale it does",
           "[open][fluid]") {
   // A parabolic inflow into a short tube: the buffer's particles move on the inlet's lattice while the fluid
   // above them disorders. With the shift counted in the density, blood that had just left the physio
