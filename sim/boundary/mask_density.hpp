@@ -76,8 +76,9 @@ class MaskDensity {
   bool recorded(uint32_t id) const { return id < record_of_.size() && record_of_[id] >= 0; }
   void index_ids();
 
-  std::vector<uint32_t> ids_, offset_{0}, row_;  // row_ sorted within each record
+  std::vector<uint32_t> ids_, offset_{0}, row_;  // row_: each record's row as built
   std::vector<int32_t> record_of_;               // by particle id: index into ids_, or -1
+  std::size_t id_bound_ = 0;                     // above every id in the record
 };
 
 }  // namespace aortasph
