@@ -15,6 +15,7 @@
 #include "cycle_report.hpp"
 #include "geometry/aortic_root.hpp"
 #include "io/probes.hpp"
+#include "physiology/coaptation.hpp"
 #include "physiology/orifice.hpp"
 #include "physiology/valve_metrics.hpp"
 #include "scene_loader.hpp"
@@ -156,6 +157,44 @@ TEST_CASE("valve metrics: cycle windows and the periodic-state test", "[physiolo
   CHECK(table.back().second == 0.0);
 }
 
+TEST_CASE("coaptation height: the band two leaflets share and not the drop of their free edge",
+          "[physiology]") {
+  // Two sheets of points facing each other across the plane x = 0, one spacing apart, along a coaptation
+  // line running out from the axis (r = z) to 10 mm; each shares a band 4 mm high with the other, under a
+  // free edge that rises by 0.8 mm per mm towards the commissure (as a closed valve's lines do). A third
+  // leaflet stands apart. The line's contact particles span 4 + 8 mm in height; the coaptation height is
+  // the band's 4 mm.
+  const double dx = 0.5e-3, band = 4e-3, slope = 0.8, reach = 10e-3;
+  std::vector<Vec3> x;
+  std::vector<int> leaf;
+  for (int side = 0; side < 2; ++side)
+    for (double zr = 0.0; zr <= reach + 1e-12; zr += dx)
+      for (double depth = 0.0; depth <= band + 1e-12; depth += dx) {
+        x.push_back(Vec3((side ? 0.5 : -0.5) * dx, 5e-3 + slope * zr - depth, zr));
+        leaf.push_back(side);
+      }
+  for (double zr = 0.0; zr <= reach; zr += dx) {
+    x.push_back(Vec3(-6e-3, 5e-3, -zr));
+    leaf.push_back(2);
+  }
+  const auto c = coaptation_stats(x, leaf, 3, Vec3::Zero(), Vec3::UnitY(), 1.5 * dx, 2 * dx, dx);
+  REQUIRE(c.height.size() == 3);
+  INFO("height " << c.height[0] * 1e3 << " mm, length " << c.length[0] * 1e3 << " mm");
+  CHECK(c.height[0] == Approx(band).margin(1e-9));
+  CHECK(c.length[0] == Approx(std::hypot(0.5 * dx, reach) - 0.5 * dx).margin(1e-9));  // r from the axis
+  CHECK(c.height[1] == 0.0);
+  CHECK(c.height[2] == 0.0);
+  // Near the axis (r < 1 mm): the band and the edge's rise over the first two bins.
+  CHECK(c.central_height == Approx(band + slope * dx).margin(1e-9));
+  CHECK(c.effective_height == Approx(5e-3 + slope * dx).margin(1e-9));
+  // The order of the points does not matter.
+  const std::vector<Vec3> xs(x.rbegin(), x.rend());
+  const std::vector<int> ls(leaf.rbegin(), leaf.rend());
+  const auto d = coaptation_stats(xs, ls, 3, Vec3::Zero(), Vec3::UnitY(), 1.5 * dx, 2 * dx, dx);
+  CHECK(d.height == c.height);
+  CHECK(d.central_height == c.central_height);
+}
+
 TEST_CASE("probes for the valve metrics: stress percentile and coaptation of the closed aortic valve",
           "[physiology][long]") {
   std::vector<double> v;
@@ -164,8 +203,8 @@ TEST_CASE("probes for the valve metrics: stress percentile and coaptation of the
   CHECK(percentile_nearest_rank({3.0}, 95.0) == 3.0);
   CHECK(percentile_nearest_rank({}, 95.0) == 0.0);
 
-  // The closed valve of aortic_root.json at t = 0: the three leaflets meet along all three coaptation lines
-  // and at the centre, below the commissures.
+  // The closed valve of aortic_root.json at t = 0: the three leaflets meet along all three coaptation lines,
+  // in a band more than a spacing high, and at the centre, below the commissures.
   const std::string file = std::string(AORTASPH_TEST_DIR) + "/../scenes/aortic_root.json";
   Scene s = load_scene(file, {}).scene;
   Probe c;
@@ -188,7 +227,7 @@ TEST_CASE("probes for the valve metrics: stress percentile and coaptation of the
   for (int p = 0; p < 3; ++p) {
     INFO("pair " << p << ": coaptation height " << values[2 * p] * 1e3 << " mm, length "
                  << values[2 * p + 1] * 1e3 << " mm");
-    CHECK(values[2 * p] > 2 * s.spacing);
+    CHECK(values[2 * p] > s.spacing);                     // the sheets meet along a band (1.46 mm at stop 56)
     CHECK(values[2 * p + 1] > 0.5 * geo.annulus_radius);  // from the centre most of the way to the wall
   }
   INFO("central coaptation height " << values[6] * 1e3 << " mm, effective height " << values[7] * 1e3

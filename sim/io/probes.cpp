@@ -14,6 +14,7 @@
 #include "core/parallel.hpp"
 #include "core/sim_errors.hpp"
 #include "geometry/shapes.hpp"
+#include "physiology/coaptation.hpp"
 #include "physiology/orifice.hpp"
 
 namespace aortasph {
@@ -133,25 +134,12 @@ double largest_principal_strain(const Eigen::Matrix3d& F) {
   return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(E, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
 }
 
-struct CoaptationStats {
-  std::vector<double> height, length;  // per leaflet pair (a < b in list order)
-  double central_height = 0.0, effective_height = 0.0;
-  std::vector<double> effective_per_leaflet;  // per leaflet: its highest particle near the axis (NaN: none)
-};
-
-// Coaptation of the listed leaflets (docs/valve-metrics.md): particles of two leaflets closer than the
-// contact distance are in contact. Per pair, the coaptation height is the extent along the valve axis of its
-// contact particles and the coaptation length their radial extent; the central coaptation height is the
-// axial extent of the contact particles within central_radius of the axis; the effective height is the axial
-// distance from the annulus plane (the probe's point and normal) to the highest leaflet particle within
-// central_radius of the axis (NaN when none is there: an open valve). Extents are max - min: independent of
-// the visiting order.
+// Coaptation of the listed leaflets (physiology/coaptation.hpp; docs/valve-metrics.md): contact within the
+// probe's distance, heights per radial bin one spacing wide.
 CoaptationStats coaptation(const World& world, const Probe& pr) {
   const Particles& P = world.particles();
-  const std::size_t nb_bodies = pr.bodies.size();
   std::vector<int> slot(world.bodies().size(), -1);
-  for (std::size_t k = 0; k < nb_bodies; ++k) slot[pr.bodies[k]] = static_cast<int>(k);
-  const Vec3 axis = pr.normal.normalized();
+  for (std::size_t k = 0; k < pr.bodies.size(); ++k) slot[pr.bodies[k]] = static_cast<int>(k);
   std::vector<Vec3> x;
   std::vector<int> leaf;
   for (std::size_t i = 0; i < P.size(); ++i)
@@ -159,55 +147,8 @@ CoaptationStats coaptation(const World& world, const Probe& pr) {
       x.push_back(P.x[i]);
       leaf.push_back(slot[P.body[i]]);
     }
-  std::vector<double> z(x.size()), r(x.size());
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    const Vec3 rel = x[i] - pr.point;
-    z[i] = rel.dot(axis);
-    r[i] = (rel - z[i] * axis).norm();
-  }
-  auto pair_index = [&](int a, int b) {
-    if (a > b) std::swap(a, b);
-    return static_cast<std::size_t>(a * static_cast<int>(nb_bodies) - a * (a + 1) / 2 + (b - a - 1));
-  };
-  const std::size_t pairs = nb_bodies * (nb_bodies - 1) / 2;
-  const double inf = std::numeric_limits<double>::infinity();
-  std::vector<double> zmin(pairs, inf), zmax(pairs, -inf), rmin(pairs, inf), rmax(pairs, -inf);
-  double czmin = inf, czmax = -inf, top = -inf;
-  std::vector<double> top_of(nb_bodies, -inf);
-  NeighborSearch nb;
-  nb.build(x, pr.distance);
-  auto mark = [&](std::size_t p, std::size_t i) {
-    zmin[p] = std::min(zmin[p], z[i]);
-    zmax[p] = std::max(zmax[p], z[i]);
-    rmin[p] = std::min(rmin[p], r[i]);
-    rmax[p] = std::max(rmax[p], r[i]);
-    if (r[i] < pr.central_radius) {
-      czmin = std::min(czmin, z[i]);
-      czmax = std::max(czmax, z[i]);
-    }
-  };
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    if (r[i] < pr.central_radius) {
-      top = std::max(top, z[i]);
-      top_of[leaf[i]] = std::max(top_of[leaf[i]], z[i]);
-    }
-    for (uint32_t k = nb.begin(i); k < nb.end(i); ++k) {
-      const uint32_t j = nb.index()[k];
-      if (j <= i || leaf[j] == leaf[i]) continue;
-      const std::size_t p = pair_index(leaf[i], leaf[j]);
-      mark(p, i);
-      mark(p, j);
-    }
-  }
-  CoaptationStats c;
-  for (std::size_t p = 0; p < pairs; ++p) {
-    c.height.push_back(zmax[p] >= zmin[p] ? zmax[p] - zmin[p] : 0.0);
-    c.length.push_back(rmax[p] >= rmin[p] ? rmax[p] - rmin[p] : 0.0);
-  }
-  c.central_height = czmax >= czmin ? czmax - czmin : 0.0;
-  c.effective_height = std::isfinite(top) ? top : kNaN;
-  for (double t : top_of) c.effective_per_leaflet.push_back(std::isfinite(t) ? t : kNaN);
-  return c;
+  return coaptation_stats(x, leaf, static_cast<int>(pr.bodies.size()), pr.point, pr.normal, pr.distance,
+                          pr.central_radius, world.scene().spacing);
 }
 
 // The unit vectors (u, v) of the plane normal to n, as orifice_area takes them (sim/physiology/orifice.cpp).
