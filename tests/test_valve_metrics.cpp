@@ -124,6 +124,24 @@ TEST_CASE("valve metrics: half-sine ejection, Gorlin and continuity EOA, opening
   CHECK(std::isnan(m.effective_height_mm));
 }
 
+TEST_CASE("valve metrics: the diastolic hold counts the previous diastole's tail at the window's start",
+          "[physiology]") {
+  // The synthetic cycle with the closed valve holding 80 mmHg over its first 9 ms (the last diastole's
+  // tail: the valve opens from 10 ms), then the ejection's -10 mmHg from 10 ms. The ramp 9 -> 10 ms crosses
+  // 70 mmHg at 9.111 ms: held 0.464 s from the closure plus 9.111 ms before the opening.
+  CycleSignals s = synthetic({400e-6}, {80.0});
+  for (std::size_t i = 0; i < s.t.size() && s.t[i] < 0.0095; ++i)
+    s.lv_pressure[i] = s.aortic_pressure[i] - 80 * kPaPerMmHg;
+  CycleOptions o;
+  o.period = 0.8;
+  o.hold_level = 70 * kPaPerMmHg;
+  const auto cycles = all_cycle_metrics(s, o);
+  REQUIRE(cycles.size() == 1);
+  CHECK(cycles[0].diastolic_dp_held_s == Approx(0.464 + 0.009 + 0.001 / 9).epsilon(1e-6));
+  // The mean over the window's own diastole (closure to the end) is unchanged.
+  CHECK(cycles[0].diastolic_dp_mean_mmHg == Approx(80.0).epsilon(1e-9));
+}
+
 TEST_CASE("valve metrics: cycle windows and the periodic-state test", "[physiology]") {
   CycleOptions o;
   o.period = 0.8;

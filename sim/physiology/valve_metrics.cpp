@@ -229,6 +229,7 @@ CycleMetrics cycle_metrics(const CycleSignals& s, double t0, double t1, const Cy
   m.peak_goa_cm2 = m.opening_time_ms = m.closing_time_ms = kNaN;
   m.closing_volume_ml = m.leakage_volume_ml = m.regurgitant_fraction_pct = kNaN;
   double t_closed = kNaN, t_reopen = t1;
+  double t_lead = t0;  // the window starts closed until here: the previous diastole's tail
   if (has(s.orifice_area)) {
     const Vec& A = s.orifice_area;
     const double a_pk = max_in(t, A, t0, t1), a_min = min_in(t, A, t0, t1);
@@ -237,6 +238,10 @@ CycleMetrics cycle_metrics(const CycleSignals& s, double t0, double t1, const Cy
     if (swing > 0) {
       const double l10 = a_min + 0.1 * swing, l90 = a_min + 0.9 * swing;
       const double t_apk = argmax_in(t, A, t0, t1);
+      if (sample(t, A, t0) < l10) {
+        const Vec up = crossings(t, A, l10, t0, t_apk, true);
+        if (!up.empty()) t_lead = up.front();
+      }
       const Vec up90 = crossings(t, A, l90, t0, t_apk, true);
       if (!up90.empty()) {
         const Vec up10 = crossings(t, A, l10, t0, up90.front(), true);
@@ -280,9 +285,14 @@ CycleMetrics cycle_metrics(const CycleSignals& s, double t0, double t1, const Cy
     const Vec back = difference(s.aortic_pressure, s.lv_pressure);
     m.diastolic_dp_mean_mmHg = integrate(t, back, t_closed, t_reopen) / (t_reopen - t_closed) * mmHg;
     m.diastolic_dp_peak_mmHg = max_in(t, back, t_closed, t_reopen) * mmHg;
-    double held = 0.0;
+    // Held: the closed valve's time at or above the hold level, in the window's diastole and in the tail of
+    // the previous one the window starts with (a diastole spans the window's end: with a waveform whose
+    // valve closes at 0.43-0.46 s of 0.8 s, [t_closed, t1] alone is under 0.4 s; in a periodic state the sum
+    // is the whole diastole's).
+    double held = 0.0, lead = 0.0;
     integral_where(t, back, back, o.hold_level, t_closed, t_reopen, 1, held);
-    m.diastolic_dp_held_s = held;
+    if (t_lead > t0) integral_where(t, back, back, o.hold_level, t0, t_lead, 1, lead);
+    m.diastolic_dp_held_s = held + lead;
   }
 
   // Leaflet stress and strain in systole (forward flow) and diastole (closed).
