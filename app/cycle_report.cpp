@@ -230,6 +230,7 @@ std::vector<CycleMetrics> cycle_metrics_of(const Scene& s, const CsvTable& table
   o.lvot_area = c.lvot_area;
   o.density = c.density;
   o.hold_level = c.hold_level;
+  o.pressure_zero = c.pressure_zero;
   std::vector<CycleMetrics> out = all_cycle_metrics(sig, o);
   if (c.cycles > 0 && static_cast<int>(out.size()) > c.cycles) out.resize(c.cycles);
   return out;
@@ -306,6 +307,8 @@ nlohmann::json cycles_json(const Scene& s, const std::vector<CycleMetrics>& cycl
     j["periodic_state"] = cycles.size() > 1 ? nlohmann::json(cycles.back().periodic) : nlohmann::json();
   }
   j["periodic_tolerance_pct"] = 2.0;
+  // The pressure that reads 0 mmHg in the LV and aortic metrics (cycle.pressure_zero).
+  j["pressure_zero_Pa"] = s.cycle->pressure_zero;
   return j;
 }
 
@@ -450,8 +453,10 @@ int make_wiggers_plot(const fs::path& dir, std::string& error) {
   }
   fs::create_directories(dir / "figures", ec);
   const fs::path png = dir / "figures" / "wiggers.png";
-  const int rc =
-      spawn({python, "-c", std::string(scripts::plot_wiggers_py), dir.string(), png.string()}, false);
+  // The pressures are drawn as the metrics read them: 0 mmHg at cycle.pressure_zero.
+  const int rc = spawn({python, "-c", std::string(scripts::plot_wiggers_py), dir.string(), png.string(),
+                        nlohmann::json(scene.cycle->pressure_zero).dump()},
+                       false);
   if (rc != 0 || !fs::is_regular_file(png, ec)) {
     error = "scripts/plot_wiggers.py failed (exit " + std::to_string(rc) + ")";
     return 2;

@@ -983,7 +983,7 @@ class Loader {
     if (type == "gap_area")
       keys.insert(keys.end(), {"bodies", "point", "normal", "radius", "central_radius", "commissures"});
     if (type == "wall_distance") keys.insert(keys.end(), {"bodies", "walls", "exclude", "reach"});
-    if (type == "max_speed") keys.insert(keys.end(), {"bodies", "region"});
+    if (type == "max_speed") keys.insert(keys.end(), {"bodies", "region", "smoothed"});
     if (type == "coaptation")
       keys.insert(keys.end(), {"bodies", "point", "normal", "distance", "central_radius", "per_leaflet"});
     if (type == "displacement") keys.insert(keys.end(), {"body", "point"});
@@ -1084,6 +1084,7 @@ class Loader {
         Obj r(o.raw("region"), o.path("region"), {"min", "max"}, allowed);
         p.region = r.box();
       }
+      p.smoothed = o.boolean("smoothed", false);
     } else if (type == "coaptation") {
       p.type = ProbeType::Coaptation;
       const auto names = o.strings("bodies");
@@ -1208,9 +1209,9 @@ class Loader {
   }
 
   static std::vector<std::string> cycle_keys() {
-    return {"period",     "cycles",       "start",      "lv_pressure", "aortic_pressure",
-            "valve_flow", "orifice_area", "jet_speed",  "lvot_flow",   "lvot_area",
-            "stress",     "coaptation",   "hold_level", "gap_area",    "wall_distance"};
+    return {"period",       "cycles",    "start",         "lv_pressure",  "aortic_pressure", "valve_flow",
+            "orifice_area", "jet_speed", "lvot_flow",     "lvot_area",    "stress",          "coaptation",
+            "hold_level",   "gap_area",  "wall_distance", "pressure_zero"};
   }
 
   // The probe a column name belongs to: a probe `name` writes the column `name` (one-column probes) or
@@ -1274,11 +1275,14 @@ class Loader {
     named_probe("gap_area", ProbeType::GapArea, "gap_area", c.gap_area);
     named_probe("wall_distance", ProbeType::WallDistance, "wall_distance", c.wall_distance);
     c.hold_level = o.non_negative("hold_level", 9332.57);
+    double background = 0.0;
     for (const Material& m : s.materials)
       if (m.type == MaterialType::Fluid) {
         c.density = m.density;
+        background = m.background_pressure;
         break;
       }
+    c.pressure_zero = o.number("pressure_zero", background);
     return c;
   }
 

@@ -2,7 +2,10 @@
 """Wiggers diagram of a finished aortasph run: LV and aortic pressure, flow through the valve and orifice area
 against time, stacked panels sharing the time axis, the last cycle's metrics beside them.
 
-Usage: plot_wiggers.py OUT_DIR [PNG]   (default PNG: OUT_DIR/figures/wiggers.png)
+Usage: plot_wiggers.py OUT_DIR [PNG [PRESSURE_ZERO_PA]]   (default PNG: OUT_DIR/figures/wiggers.png)
+
+The pressures are drawn less PRESSURE_ZERO_PA (the scene's cycle.pressure_zero; default: what run.json
+records as cycles.pressure_zero_Pa, else 0), as the metrics in cycles.csv read them.
 
 Reads OUT_DIR/run.json (the scene's "cycle" block names the probe columns), OUT_DIR/probes.csv and
 OUT_DIR/cycles.csv. `aortasph plot OUT_DIR` runs this script (embedded in the binary) after checking the
@@ -45,17 +48,27 @@ def column(header, data, name, path):
 
 
 def main(argv):
-    if len(argv) < 1 or len(argv) > 2:
-        fail("usage: plot_wiggers.py OUT_DIR [PNG]")
+    if len(argv) < 1 or len(argv) > 3:
+        fail("usage: plot_wiggers.py OUT_DIR [PNG [PRESSURE_ZERO_PA]]")
     out_dir = argv[0]
-    png = argv[1] if len(argv) == 2 else os.path.join(out_dir, "figures", "wiggers.png")
+    png = argv[1] if len(argv) >= 2 else os.path.join(out_dir, "figures", "wiggers.png")
     run_json = os.path.join(out_dir, "run.json")
     if not os.path.isfile(run_json):
         fail(run_json + ": missing")
     with open(run_json) as f:
-        cycle = json.load(f).get("scene", {}).get("cycle")
+        run = json.load(f)
+    cycle = run.get("scene", {}).get("cycle")
     if not cycle:
         fail(run_json + ": the scene has no cycle block")
+    # The fluid pressure that reads 0 mmHg (cycle.pressure_zero, resolved by aortasph): the argument, else
+    # what run.json recorded, else 0 (runs before stop 57).
+    if len(argv) == 3:
+        try:
+            zero = float(argv[2])
+        except ValueError:
+            fail("PRESSURE_ZERO_PA: expected a number, got '" + argv[2] + "'")
+    else:
+        zero = float(run.get("cycles", {}).get("pressure_zero_Pa", 0.0))
 
     import matplotlib
 
@@ -65,8 +78,8 @@ def main(argv):
     probes = os.path.join(out_dir, "probes.csv")
     header, data = read_table(probes)
     t = column(header, data, "time", probes)
-    lv = [p / MMHG for p in column(header, data, cycle["lv_pressure"], probes)]
-    ao = [p / MMHG for p in column(header, data, cycle["aortic_pressure"], probes)]
+    lv = [(p - zero) / MMHG for p in column(header, data, cycle["lv_pressure"], probes)]
+    ao = [(p - zero) / MMHG for p in column(header, data, cycle["aortic_pressure"], probes)]
     q = [v * 1e6 for v in column(header, data, cycle["valve_flow"], probes)]
     area = None
     if cycle.get("orifice_area"):
@@ -85,7 +98,7 @@ def main(argv):
 
     axes[0].plot(t, lv, color="tab:red", lw=1.2, label="LV (upstream)")
     axes[0].plot(t, ao, color="tab:blue", lw=1.2, label="aortic (downstream)")
-    axes[0].set_ylabel("pressure [mmHg]")
+    axes[0].set_ylabel("pressure [mmHg]" if zero == 0.0 else "pressure [mmHg] (0 at %g Pa)" % zero)
     axes[0].legend(loc="upper right", fontsize=8)
     axes[1].plot(t, q, color="black", lw=1.2)
     axes[1].axhline(0.0, color="grey", lw=0.6)

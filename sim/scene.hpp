@@ -282,6 +282,7 @@ struct Probe {
   double central_radius = 0.0;    // coaptation, gap_area: radius about the axis counted as the centre [m]
   std::vector<Vec3> commissures;  // gap_area: the commissures (only their direction about the axis counts)
   bool per_body = false;          // stress: per body max, p95 and the peak's place (docs/valve-metrics.md)
+  bool smoothed = false;          // max_speed: the speed of the kernel-averaged velocity (docs/scenes.md)
   std::vector<int> walls;         // wall_distance: the wall bodies
   double exclude = 0.0;           // wall_distance: leaflet particles this close to a wall at t = 0 left out
   double reach = 0.0;             // wall_distance: distances are capped here [m]
@@ -388,6 +389,9 @@ struct CycleSpec {
   std::string wall_distance;    // a wall_distance probe's name
   double hold_level = 9332.57;  // [Pa] diastolic pressure difference counted as held (70 mmHg)
   double density = 1060.0;      // [kg/m^3] fluid density for the Gorlin EOA
+  // [Pa] the fluid pressure that reads 0 mmHg in the LV and aortic pressure metrics (default: the first
+  // fluid's background_pressure, the pressure of blood at rest)
+  double pressure_zero = 0.0;
 };
 
 struct Scene {

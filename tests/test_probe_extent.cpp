@@ -133,3 +133,77 @@ TEST_CASE("extent probe: the loader reads \"stat\": \"extent\" and its link", "[
   CHECK(v[1] == Approx(0.1).margin(1e-12));
   CHECK(v[2] == Approx(0.1).margin(1e-12));
 }
+
+TEST_CASE("max_speed probe: smoothed reads the kernel-averaged velocity and not one fast particle",
+          "[probes][physiology]") {
+  // A 10 x 10 x 6 block of water moving at 1 m/s along x with, inside it (a full kernel support around it),
+  // one particle at 5 m/s (the single fast particle of the physio run's jet at stop 56). The block is built
+  // of boxes around that particle's lattice cell [0.05, 0.06] x [0.05, 0.06] x [0.02, 0.03].
+  Scene s;
+  s.name = "max_speed_test";
+  s.spacing = 0.01;
+  s.gravity = Vec3::Zero();
+  s.domain = {Vec3(-0.1, -0.1, -0.1), Vec3(0.4, 0.2, 0.2)};
+  s.materials = {water(10.0)};
+  const Vec3 U(1, 0, 0);
+  s.bodies = {box_body("x_low", 0, Vec3(0, 0, 0), Vec3(0.05, 0.1, 0.06), U),
+              box_body("x_high", 0, Vec3(0.06, 0, 0), Vec3(0.1, 0.1, 0.06), U),
+              box_body("y_low", 0, Vec3(0.05, 0, 0), Vec3(0.06, 0.05, 0.06), U),
+              box_body("y_high", 0, Vec3(0.05, 0.06, 0), Vec3(0.06, 0.1, 0.06), U),
+              box_body("z_low", 0, Vec3(0.05, 0.05, 0), Vec3(0.06, 0.06, 0.02), U),
+              box_body("z_high", 0, Vec3(0.05, 0.05, 0.03), Vec3(0.06, 0.06, 0.06), U),
+              box_body("spike", 0, Vec3(0.05, 0.05, 0.02), Vec3(0.06, 0.06, 0.03), Vec3(5, 0, 0))};
+  for (const bool smoothed : {false, true}) {
+    Probe p;
+    p.name = smoothed ? "smooth" : "raw";
+    p.type = ProbeType::MaxSpeed;
+    p.smoothed = smoothed;
+    s.probes.push_back(p);
+  }
+  // The same two in a region that leaves the fast particle (x = 0.055) out but not its kernel support.
+  for (Probe p : std::vector<Probe>(s.probes)) {
+    p.name += "_region";
+    p.region = Box{Vec3(-1, -1, -1), Vec3(0.05, 1, 1)};
+    s.probes.push_back(p);
+  }
+  const World w(s);
+  const auto v = ProbeSet(s, w).measure(w);
+  REQUIRE(v.size() == 4);
+  CHECK(v[0] == Approx(5.0).epsilon(1e-12));
+  CHECK(v[2] == Approx(1.0).epsilon(1e-12));
+  // The Shepard average sum_j V_j v_j W_ij / sum_j V_j W_ij over the fluid within 2h, by brute force.
+  const Particles& P = w.particles();
+  const CubicSpline& K = w.kernel();
+  auto smoothed_speed = [&](std::size_t i) {
+    Vec3 vw = Vec3::Zero();
+    double sw = 0.0;
+    for (std::size_t j = 0; j < P.size(); ++j) {
+      const double r = (P.x[j] - P.x[i]).norm();
+      if (P.kind[j] != Kind::Fluid || r >= K.support) continue;
+      const double Wj = K.W(r) * P.m[j] / P.rho[j];
+      vw += Wj * P.v[j];
+      sw += Wj;
+    }
+    return (vw / sw).norm();
+  };
+  double all = 0.0, region = 0.0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    all = std::max(all, smoothed_speed(i));
+    if (P.x[i].x() <= 0.05) region = std::max(region, smoothed_speed(i));
+  }
+  CHECK(v[1] == Approx(all).epsilon(1e-12));
+  CHECK(v[3] == Approx(region).epsilon(1e-12));
+  // The fast particle counts for its kernel share W(0) V / sum_j W_j V_j, about 2/3 alpha dx^3 = 0.145 in a
+  // full support at h = 1.3 dx: 1 + 4 x 0.145 = 1.58 m/s where it sits, not 5; and inside the region its
+  // neighbours outside it still count (above 1 m/s).
+  CHECK(v[1] > 1.4);
+  CHECK(v[1] < 1.75);
+  CHECK(v[3] > 1.0 + 1e-6);
+  CHECK(v[3] < v[1]);
+  // A uniform flow reads its own speed.
+  s.bodies.pop_back();
+  const World u(s);
+  const auto vu = ProbeSet(s, u).measure(u);
+  CHECK(vu[0] == Approx(1.0).epsilon(1e-12));
+  CHECK(vu[1] == Approx(1.0).epsilon(1e-12));
+}

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <tuple>
 
 #include "cli_helpers.hpp"
 #include "core/parallel.hpp"
@@ -140,6 +141,41 @@ TEST_CASE("valve metrics: the diastolic hold counts the previous diastole's tail
   CHECK(cycles[0].diastolic_dp_held_s == Approx(0.464 + 0.009 + 0.001 / 9).epsilon(1e-6));
   // The mean over the window's own diastole (closure to the end) is unchanged.
   CHECK(cycles[0].diastolic_dp_mean_mmHg == Approx(80.0).epsilon(1e-9));
+}
+
+TEST_CASE("valve metrics: pressure_zero moves the LV and aortic pressures and no pressure difference",
+          "[physiology]") {
+  // The fluid's pressures are absolute in its terms (a 2000 Pa background in the physio scene); clinical ones
+  // read 0 mmHg at rest. The synthetic cycle with 2000 Pa added to both pressures and pressure_zero 2000 Pa
+  // reads as the cycle without them; with pressure_zero 0 its LV and aortic pressures read 15.0 mmHg high.
+  const CycleSignals s = synthetic({400e-6}, {80.0});
+  CycleSignals lifted = s;
+  for (double& p : lifted.lv_pressure) p += 2000.0;
+  for (double& p : lifted.aortic_pressure) p += 2000.0;
+  CycleOptions o;
+  o.period = 0.8;
+  o.hold_level = 70 * kPaPerMmHg;
+  const CycleMetrics base = all_cycle_metrics(s, o).at(0);
+  const CycleMetrics raw = all_cycle_metrics(lifted, o).at(0);
+  o.pressure_zero = 2000.0;
+  const CycleMetrics zeroed = all_cycle_metrics(lifted, o).at(0);
+  const double lift = 2000.0 / kPaPerMmHg;  // 15.0 mmHg
+  for (const auto& [a, b, c] :
+       {std::tuple{base.aortic_systolic_mmHg, raw.aortic_systolic_mmHg, zeroed.aortic_systolic_mmHg},
+        {base.aortic_diastolic_mmHg, raw.aortic_diastolic_mmHg, zeroed.aortic_diastolic_mmHg},
+        {base.aortic_end_diastolic_mmHg, raw.aortic_end_diastolic_mmHg, zeroed.aortic_end_diastolic_mmHg},
+        {base.lv_peak_mmHg, raw.lv_peak_mmHg, zeroed.lv_peak_mmHg},
+        {base.lv_end_diastolic_mmHg, raw.lv_end_diastolic_mmHg, zeroed.lv_end_diastolic_mmHg}}) {
+    CHECK(b == Approx(a + lift).epsilon(1e-12));
+    CHECK(c == Approx(a).margin(1e-9));
+  }
+  CHECK(base.aortic_end_diastolic_mmHg == Approx(80.0).epsilon(1e-6));
+  // Differences do not depend on the zero.
+  CHECK(zeroed.peak_gradient_mmHg == Approx(raw.peak_gradient_mmHg).epsilon(1e-12));
+  CHECK(zeroed.mean_gradient_mmHg == Approx(raw.mean_gradient_mmHg).epsilon(1e-12));
+  CHECK(zeroed.diastolic_dp_mean_mmHg == Approx(raw.diastolic_dp_mean_mmHg).epsilon(1e-12));
+  CHECK(zeroed.diastolic_dp_held_s == Approx(raw.diastolic_dp_held_s).epsilon(1e-12));
+  CHECK(zeroed.eoa_gorlin_cm2 == Approx(raw.eoa_gorlin_cm2).epsilon(1e-12));
 }
 
 TEST_CASE("valve metrics: cycle windows and the periodic-state test", "[physiology]") {
@@ -339,6 +375,16 @@ TEST_CASE("cycle block: a short pulsatile tube run writes cycles.csv, run.json m
         Approx(cycles.rows[1][cycles.column("stroke_volume_ml")]));
   CHECK(c["periodic_state"].is_boolean());
   CHECK(c["per_cycle"][0]["periodic"].is_null());
+  // 0 mmHg is the fluid's rest pressure by default (cycle.pressure_zero: tube_flow's background_pressure,
+  // 200 Pa): the end-diastolic aortic pressure is the outlet probe's last row less 200 Pa.
+  CHECK(c["pressure_zero_Pa"].get<double>() == 200.0);
+  {
+    const CsvTable probes = read_csv(out / "probes.csv");
+    const auto& last = probes.rows.back();
+    REQUIRE(last[probes.column("time")] == Approx(0.12));
+    CHECK(cycles.rows[1][cycles.column("aortic_end_diastolic_mmHg")] ==
+          Approx((last[probes.column("p_out")] - 200.0) / kPaPerMmHg).epsilon(1e-9));
+  }
 
   // aortasph plot on the finished run: a PNG (CI installs python3-matplotlib; here it may be absent).
   const bool matplotlib = std::system("/usr/bin/python3 -c 'import matplotlib' > /dev/null 2>&1") == 0 ||
@@ -399,6 +445,7 @@ TEST_CASE("cycle block: bad input exits 2 naming the JSON path", "[physiology][b
       {"period", -0.06, "cycle.period: must be positive"},
       {"stress", "q_mid", "cycle.stress: probe 'q_mid' is not a stress probe"},
       {"cycles", 0, "cycle.cycles: expected an integer in 1..100000"},
+      {"pressure_zero", "rest", "cycle.pressure_zero: expected a number"},
   };
   for (const Case& c : cases) {
     nlohmann::json cycle = good_cycle();
@@ -420,6 +467,14 @@ TEST_CASE("cycle block: bad input exits 2 naming the JSON path", "[physiology][b
   cycle.erase("cycles");
   CHECK(run_cli("check " + tube_cycle_scene(dir, cycle).string(), err) == 2);
   CHECK(err.find("time.end: missing") != std::string::npos);
+  // The jet's max_speed probe (the sixth) with a smoothed flag that is not a boolean.
+  const fs::path scene = tube_cycle_scene(dir, good_cycle());
+  nlohmann::json j = nlohmann::json::parse(slurp(scene));
+  REQUIRE(j["probes"][5]["name"] == "jet");
+  j["probes"][5]["smoothed"] = "yes";
+  std::ofstream(scene) << j.dump(1);
+  CHECK(run_cli("check " + scene.string(), err) == 2);
+  CHECK(err.find("probes[5].smoothed: expected true or false") != std::string::npos);
 }
 
 TEST_CASE("stress probe: 95th percentile and peak strain of a sagging cantilever", "[physiology]") {

@@ -272,14 +272,15 @@ CycleMetrics cycle_metrics(const CycleSignals& s, double t0, double t1, const Cy
   m.diastolic_dp_mean_mmHg = m.diastolic_dp_peak_mmHg = m.diastolic_dp_held_s = kNaN;
   m.lv_peak_mmHg = m.lv_end_diastolic_mmHg = kNaN;
   m.aortic_systolic_mmHg = m.aortic_diastolic_mmHg = m.aortic_end_diastolic_mmHg = kNaN;
+  const double zero = o.pressure_zero;
   if (has(s.lv_pressure)) {
-    m.lv_peak_mmHg = max_in(t, s.lv_pressure, t0, t1) * mmHg;
-    m.lv_end_diastolic_mmHg = sample(t, s.lv_pressure, t1) * mmHg;
+    m.lv_peak_mmHg = (max_in(t, s.lv_pressure, t0, t1) - zero) * mmHg;
+    m.lv_end_diastolic_mmHg = (sample(t, s.lv_pressure, t1) - zero) * mmHg;
   }
   if (has(s.aortic_pressure)) {
-    m.aortic_systolic_mmHg = max_in(t, s.aortic_pressure, t0, t1) * mmHg;
-    m.aortic_diastolic_mmHg = min_in(t, s.aortic_pressure, t0, t1) * mmHg;
-    m.aortic_end_diastolic_mmHg = sample(t, s.aortic_pressure, t1) * mmHg;
+    m.aortic_systolic_mmHg = (max_in(t, s.aortic_pressure, t0, t1) - zero) * mmHg;
+    m.aortic_diastolic_mmHg = (min_in(t, s.aortic_pressure, t0, t1) - zero) * mmHg;
+    m.aortic_end_diastolic_mmHg = (sample(t, s.aortic_pressure, t1) - zero) * mmHg;
   }
   if (pressures && closed && t_reopen > t_closed) {
     const Vec back = difference(s.aortic_pressure, s.lv_pressure);

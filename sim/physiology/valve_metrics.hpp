@@ -54,6 +54,10 @@ struct CycleOptions {
   double lvot_area = 0.0;       // [m^2], continuity EOA; 0: not measurable
   double density = 1060.0;      // fluid density [kg/m^3], Gorlin EOA (ISO 5840 form)
   double hold_level = 9332.57;  // [Pa] the diastolic pressure difference counted as held (70 mmHg)
+  // [Pa] the pressure that reads 0 mmHg in the LV and aortic pressures (clinical pressures are gauge
+  // pressures; the fluid's are absolute in its terms, its background pressure included). Differences
+  // (gradients, the diastolic difference) do not depend on it.
+  double pressure_zero = 0.0;
 };
 
 // The metrics of one cycle, in the units of their names; NaN where not measurable.
