@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "embedded_scripts.hpp"
@@ -381,6 +382,10 @@ std::string find_python() {
 }  // namespace
 
 int make_wiggers_plot(const fs::path& dir, std::string& error) {
+  return make_wiggers_plot(dir, false, error);
+}
+
+int make_wiggers_plot(const fs::path& dir, bool remeasure, std::string& error) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) {
     error = dir.string() + ": no such folder";
@@ -393,9 +398,10 @@ int make_wiggers_plot(const fs::path& dir, std::string& error) {
   };
   if (!fs::is_regular_file(run_json, ec)) return missing(run_json);
   Scene scene;
+  nlohmann::json j;
   try {
     std::ifstream in(run_json);
-    const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    j = nlohmann::json::parse(in, nullptr, false);
     if (j.is_discarded() || !j.is_object() || !j.contains("scene") || !j["scene"].is_object()) {
       error = run_json.string() + ": not a run.json (no scene)";
       return 2;
@@ -438,6 +444,23 @@ int make_wiggers_plot(const fs::path& dir, std::string& error) {
       error = probes.string() + ": fewer than two rows";
       return 2;
     }
+    if (remeasure) {
+      // The cycles measured again with this program's definitions (docs/valve-metrics.md), as a run
+      // measures them: from probes.csv and diagnostics.csv; cycles.csv and run.json's "cycles" rewritten.
+      const fs::path diag = dir / "diagnostics.csv";
+      std::optional<CsvTable> diagnostics;
+      if (fs::is_regular_file(diag, ec)) diagnostics = read_csv(diag);
+      const std::vector<CycleMetrics> measured =
+          cycle_metrics_of(scene, table, diagnostics ? &*diagnostics : nullptr);
+      write_cycles_csv(cycles, measured, scene);
+      j["cycles"] = cycles_json(scene, measured);
+      std::ofstream out(run_json, std::ios::trunc);
+      out << j.dump(2) << "\n";
+      out.close();
+      if (!out) throw InputError(run_json.string() + ": write failed (disk full?)");
+      for (const CycleMetrics& m : measured) std::printf("aortasph: %s\n", cycle_line(m).c_str());
+      std::fflush(stdout);
+    }
     read_csv(cycles);
   } catch (const InputError& e) {
     const std::string what = e.what();
@@ -465,17 +488,33 @@ int make_wiggers_plot(const fs::path& dir, std::string& error) {
 }
 
 int cmd_plot(const std::vector<std::string>& args) {
-  if (args.size() != 1 || args[0].empty() || args[0][0] == '-') {
-    std::fprintf(stderr, "aortasph plot: error: expected one output folder\nusage: aortasph plot OUT_DIR\n");
+  std::vector<std::string> dirs;
+  bool remeasure = false;
+  for (const std::string& a : args) {
+    if (a == "--remeasure") {
+      remeasure = true;
+    } else if (a.empty() || a[0] == '-') {
+      std::fprintf(stderr,
+                   "aortasph plot: error: unknown option '%s'\nusage: aortasph plot OUT_DIR [--remeasure]\n",
+                   a.c_str());
+      return 2;
+    } else {
+      dirs.push_back(a);
+    }
+  }
+  if (dirs.size() != 1) {
+    std::fprintf(
+        stderr,
+        "aortasph plot: error: expected one output folder\nusage: aortasph plot OUT_DIR [--remeasure]\n");
     return 2;
   }
   std::string error;
-  const int rc = make_wiggers_plot(args[0], error);
+  const int rc = make_wiggers_plot(dirs[0], remeasure, error);
   if (rc != 0) {
     std::fprintf(stderr, "aortasph plot: error: %s\n", error.c_str());
     return rc;
   }
-  std::printf("%s\n", (fs::path(args[0]) / "figures" / "wiggers.png").string().c_str());
+  std::printf("%s\n", (fs::path(dirs[0]) / "figures" / "wiggers.png").string().c_str());
   return 0;
 }
 

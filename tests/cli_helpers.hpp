@@ -30,13 +30,21 @@ inline std::string slurp(const std::filesystem::path& p) {
   return s.str();
 }
 
-// Runs `aortasph ARGS` (stdout discarded): its exit code (-1 when it did not exit), its stderr in err.
-inline int run_cli(const std::string& args, std::string& err) {
-  const auto e = std::filesystem::temp_directory_path() / ("aortasph_test_err_" + std::to_string(::getpid()));
-  const std::string cmd = std::string(AORTASPH_BINARY) + " " + args + " > /dev/null 2> " + e.string();
+// Runs `aortasph ARGS`: its exit code (-1 when it did not exit), its stderr in err and, when out is given,
+// its stdout there (else discarded).
+inline int run_cli(const std::string& args, std::string& err, std::string* out = nullptr) {
+  const auto tmp = std::filesystem::temp_directory_path();
+  const auto e = tmp / ("aortasph_test_err_" + std::to_string(::getpid()));
+  const auto o = tmp / ("aortasph_test_out_" + std::to_string(::getpid()));
+  const std::string cmd = std::string(AORTASPH_BINARY) + " " + args + " > " +
+                          (out ? o.string() : std::string("/dev/null")) + " 2> " + e.string();
   const int status = std::system(cmd.c_str());
   err = slurp(e);
   std::filesystem::remove(e);
+  if (out) {
+    *out = slurp(o);
+    std::filesystem::remove(o);
+  }
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 

@@ -398,6 +398,31 @@ TEST_CASE("cycle block: a short pulsatile tube run writes cycles.csv, run.json m
   const std::string png = slurp(out / "figures" / "wiggers.png");
   CHECK(png.size() > 10000);
   CHECK(png.substr(1, 3) == "PNG");
+  // --remeasure: the cycles measured again from probes.csv with the scene run.json records. With the
+  // recorded cycle.pressure_zero set to 0 the end-diastolic aortic pressure reads 200 Pa (1.50 mmHg) higher
+  // and the stroke volume is unchanged; run.json follows.
+  {
+    const CsvTable before = read_csv(out / "cycles.csv");
+    nlohmann::json recorded = nlohmann::json::parse(slurp(out / "run.json"));
+    recorded["scene"]["cycle"]["pressure_zero"] = 0.0;
+    std::ofstream(out / "run.json") << recorded.dump(2);
+    std::string printed;
+    REQUIRE(run_cli("plot " + out.string() + " --remeasure", err, &printed) == 0);
+    CHECK(printed.find("cycle 1 [0.06, 0.12] s: SV") != std::string::npos);
+    const CsvTable after = read_csv(out / "cycles.csv");
+    REQUIRE(after.rows.size() == 2);
+    const int edp = after.column("aortic_end_diastolic_mmHg"), sv = after.column("stroke_volume_ml");
+    for (std::size_t r = 0; r < 2; ++r) {
+      CHECK(after.rows[r][edp] == Approx(before.rows[r][edp] + 200.0 / kPaPerMmHg).epsilon(1e-9));
+      CHECK(after.rows[r][sv] == before.rows[r][sv]);
+    }
+    const nlohmann::json rerun = nlohmann::json::parse(slurp(out / "run.json"));
+    CHECK(rerun["cycles"]["pressure_zero_Pa"].get<double>() == 0.0);
+    CHECK(rerun["cycles"]["metrics"]["aortic_end_diastolic_mmHg"].get<double>() ==
+          Approx(after.rows[1][edp]));
+    CHECK(run_cli("plot " + out.string() + " --again", err) == 2);
+    CHECK(err.find("unknown option '--again'") != std::string::npos);
+  }
   // A probes.csv without the columns the cycle block names: exit 2 naming the key and the column.
   { std::ofstream(out / "probes.csv") << "time,q_mid\n0,0\n0.06,0\n"; }
   CHECK(run_cli("plot " + out.string(), err) == 2);
