@@ -7,10 +7,13 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "commands.hpp"
@@ -130,6 +133,43 @@ std::vector<double> diagnostics_row(const World& w) {
   for (const auto& [name, sec] : w.profile().phases()) row.push_back(sec);
   row.push_back(w.profile().total());
   return row;
+}
+
+// shell_putbacks.csv: one row per fluid particle the shell coupling's guard put back on its side of a sheet
+// (World::last_shell_put_backs), appended as they happen. A new run starts the file with its header; a
+// resumed one keeps the whole rows up to its checkpoint's time (keep_until >= 0) and drops the rest.
+std::ofstream open_put_backs(const std::filesystem::path& file, double keep_until) {
+  std::string kept = "time,id,x,y,z,body,depth,sheet\n";
+  if (keep_until >= 0.0) {
+    std::ifstream in(file, std::ios::binary);
+    std::string line;
+    if (in && std::getline(in, line))  // runs before stop 57 wrote none: a new file then
+      while (std::getline(in, line) && !in.eof())
+        if (std::strtod(line.c_str(), nullptr) <= keep_until * (1.0 + 1e-12)) kept += line + "\n";
+  }
+  std::filesystem::path tmp = file;
+  tmp += ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    f << kept;
+    f.close();
+    if (!f) throw InputError(tmp.string() + ": write failed (disk full?)");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, file, ec);
+  if (ec) throw InputError(file.string() + ": cannot replace: " + ec.message());
+  std::ofstream out(file, std::ios::binary | std::ios::app);
+  if (!out) throw InputError(file.string() + ": cannot open for writing");
+  return out;
+}
+
+void write_put_backs(std::ofstream& out, const World& w) {
+  const auto& put_backs = w.last_shell_put_backs();
+  for (const auto& p : put_backs)
+    out << format_number(w.time()) << ',' << p.id << ',' << format_number(p.x.x()) << ','
+        << format_number(p.x.y()) << ',' << format_number(p.x.z()) << ',' << p.body << ','
+        << format_number(p.depth) << ',' << (p.sheet ? 1 : 0) << '\n';
+  if (!put_backs.empty()) out.flush();
 }
 
 // Creates the output folder and proves it is writable before anything is simulated.
@@ -333,6 +373,9 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
                      " s (resume --end-time T with T later)");
   std::optional<CsvWriter> probe_csv, diag_csv;
   std::optional<VtkWriter> vtk;
+  std::optional<std::ofstream> put_backs;  // scenes with shells
+  if (!world.shells().empty())
+    put_backs = open_put_backs(dir / "shell_putbacks.csv", resume ? world.time() : -1.0);
   if (resume) {
     probe_csv.emplace(dir / "probes.csv", probes.columns(), first_frame);
     diag_csv.emplace(dir / "diagnostics.csv", diagnostics_columns(), first_frame);
@@ -503,6 +546,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
       if (target <= world.time()) break;
       const bool reached = world.advance_to(target, [&] {
         progress.update(world);
+        if (put_backs) write_put_backs(*put_backs, world);
         return !g_interrupted.load();
       });
       if (!reached) break;  // interrupted between outputs: no partial row, everything before stays valid

@@ -145,6 +145,10 @@ class World {
   // Fluid on both sides of the shells (sim/boundary/shell_coupling.hpp): fluid particles put back on their
   // side of a sheet since t = 0 (0 when the coupling holds), and the pairs masked in the last step.
   long shell_crossings() const { return coupling_.crossings(); }
+  // The put-backs of the last step, each with its particle, place, body and depth (ShellCoupling::PutBack).
+  const std::vector<ShellCoupling::PutBack>& last_shell_put_backs() const {
+    return coupling_.last_put_backs();
+  }
   long shell_label_disagreements() const { return coupling_.label_disagreements(); }
   // The side of shell body `body` on which the last step found particle i (ShellCoupling::side).
   int shell_side(uint32_t i, uint16_t body) const { return coupling_.side(i, body); }

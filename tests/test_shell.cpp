@@ -666,8 +666,8 @@ TEST_CASE("shell: bad input exits 2 naming the key", "[shell][bad-input]") {
   // The good scene runs and writes the displacement columns (and, with --vtk, the directors).
   std::ofstream(dir / "scene.json") << good;
   std::string err;
-  CHECK(run_cli("run " + (dir / "scene.json").string() + " --no-render --vtk --quiet --out " +
-                    (dir / "out").string(),
+  CHECK(run_cli("run " + (dir / "scene.json").string() +
+                    " --no-render --vtk --quiet --checkpoint-every 0.0002 --out " + (dir / "out").string(),
                 err) == 0);
   const std::string csv = slurp(dir / "out" / "probes.csv");
   CHECK(csv.find("tip.ux,tip.uy,tip.uz") != std::string::npos);
@@ -675,6 +675,15 @@ TEST_CASE("shell: bad input exits 2 naming the key", "[shell][bad-input]") {
   const std::string vtp = slurp(dir / "out" / "vtk" / "particles_00001.vtp");
   CHECK(vtp.find("Name=\"director\"") != std::string::npos);
   CHECK(vtp.find("Name=\"thickness\"") != std::string::npos);
+  // shell_putbacks.csv: a scene with shells writes it, its header and no row here (no fluid). A resumed run
+  // keeps the rows up to its checkpoint (the end, 0.2 ms) and drops those after it (as a run killed after
+  // writing them and before its next checkpoint would leave them) and a torn last line.
+  const std::string header = "time,id,x,y,z,body,depth,sheet\n";
+  CHECK(slurp(dir / "out" / "shell_putbacks.csv") == header);
+  const std::string before = "0.0001,7,0,0,0,0,1e-05,1\n", after = "0.0002001,8,0,0,0,0,1e-05,0\n";
+  { std::ofstream(dir / "out" / "shell_putbacks.csv", std::ios::app) << before << after << "0.0001,9,0"; }
+  CHECK(run_cli("resume " + (dir / "out").string() + " --end-time 0.0003 --quiet", err) == 0);
+  CHECK(slurp(dir / "out" / "shell_putbacks.csv") == header + before);
 }
 
 TEST_CASE("shell: a checkpoint resumes bitwise (directors and spin included)", "[shell][checkpoint]") {

@@ -448,7 +448,8 @@ Scene free_edge_scene(const std::string& name, double held_to, Body& sheet) {
   return s;
 }
 
-std::pair<long, double> skim_free_edge(double barrier) {
+std::pair<long, double> skim_free_edge(double barrier, std::vector<ShellCoupling::PutBack>* records = nullptr,
+                                       uint32_t* water_id = nullptr) {
   const double dx = 0.01;
   Body sheet;
   Scene s = free_edge_scene("skim", 0.08, sheet);  // all but the last two rows held
@@ -460,7 +461,12 @@ std::pair<long, double> skim_free_edge(double barrier) {
   double lowest = 1e30;
   w.advance_to(0.01, [&] {
     for (std::size_t i = 0; i < w.particles().size(); ++i)
-      if (w.particles().kind[i] == Kind::Fluid) lowest = std::min(lowest, w.particles().x[i].y());
+      if (w.particles().kind[i] == Kind::Fluid) {
+        lowest = std::min(lowest, w.particles().x[i].y());
+        if (water_id) *water_id = w.particles().id[i];
+      }
+    if (records)
+      records->insert(records->end(), w.last_shell_put_backs().begin(), w.last_shell_put_backs().end());
     return true;
   });
   return {w.shell_crossings(), lowest};
@@ -589,12 +595,27 @@ TEST_CASE("shell-fluid: the barrier keeps water skimming a free edge's plane on 
   // Beside a free edge the imaginary particles are beside the fluid particle, not under it, and a particle in
   // the sheet's plane has no pressure pushing it off: without the barrier the guard has to put it back.
   const auto [on, low_on] = skim_free_edge(1.0);
-  const auto [off, low_off] = skim_free_edge(0.0);
+  std::vector<ShellCoupling::PutBack> records;
+  uint32_t water = 0;
+  const auto [off, low_off] = skim_free_edge(0.0, &records, &water);
   INFO("barrier on: " << on << " put-backs, lowest " << low_on << " m; off: " << off << " put-backs, lowest "
                       << low_off << " m");
   CHECK(off > 0);  // the case needs the barrier
   CHECK(on == 0);
   CHECK(low_on > 0.0);  // it never crossed the plane
+  // Each put-back is recorded where it happened (World::last_shell_put_backs, shell_putbacks.csv of a run):
+  // the water particle, found under the sheet's plane (it came from above) within the step's motion, by the
+  // sheet (body 0) near its free edge row (x = 0.095; its patches reach the rim at x = 0.1).
+  REQUIRE(static_cast<long>(records.size()) == off);
+  for (const ShellCoupling::PutBack& r : records) {
+    CHECK(r.id == water);
+    CHECK(r.body == 0);
+    CHECK(r.x.y() < 0.0);
+    CHECK(r.depth == Approx(-r.x.y()).margin(1e-3));
+    CHECK(r.depth < 0.01);
+    CHECK(r.x.x() > 0.08);
+    CHECK(r.x.x() < 0.11);
+  }
 }
 
 TEST_CASE("shell-fluid: the barrier rounds a free edge's rim: water aimed at it keeps off it",

@@ -566,8 +566,10 @@ ShellCoupling::Closest ShellCoupling::closest_on_sheet(const Particles& P, const
 }
 
 std::size_t ShellCoupling::guard(Particles& P, const Shells& shells, const Periodic& per, double dt) {
+  put_backs_.clear();
   if (!active_) return 0;
   std::vector<uint8_t> moved(band_.size(), 0), disagree(band_.size(), 0);
+  if (put_back_scratch_.size() < band_.size()) put_back_scratch_.resize(band_.size());
   const double reach = kGuardReach * dx_;
   parallel_for(band_.size(), [&](std::size_t r) {
     const uint32_t a = band_[r];
@@ -578,6 +580,7 @@ std::size_t ShellCoupling::guard(Particles& P, const Shells& shells, const Perio
       Vec3 nrm = wall_.normal[l.nearest];
       const Vec3 d = per.any ? per.image(P.x[a] - P.x[l.nearest]) : Vec3(P.x[a] - P.x[l.nearest]);
       double s = nrm.dot(d);
+      bool by_sheet = false;
       const std::size_t sl = static_cast<std::size_t>(shells.slot(l.nearest));
       if (shells.normal(sl).dot(d) * l.side > reach) continue;
       const Closest c = closest_on_sheet(P, shells, per, a, sl);
@@ -591,6 +594,7 @@ std::size_t ShellCoupling::guard(Particles& P, const Shells& shells, const Perio
         }
         nrm = c.n;
         s = c.sigma;
+        by_sheet = true;
       } else {
         // Beyond the outline: round an edge is allowed; in a hole of the sheet (an interior label), or with
         // no triangles, the tangent plane decides (near an edge: a path through its patches).
@@ -598,6 +602,7 @@ std::size_t ShellCoupling::guard(Particles& P, const Shells& shells, const Perio
         if (l.edge && !segment_pierces(P, per, x_before_[r], P.x[a], static_cast<int32_t>(r), l.body))
           continue;
       }
+      if (!moved[r]) put_back_scratch_[r] = PutBack{P.id[a], P.x[a], l.body, std::abs(s), by_sheet};
       P.x[a] += (l.side * 0.1 * dx_ - s) * nrm;
       if (per.any) per.wrap(P.x[a]);
       const double vr = (P.v[a] - P.v[l.nearest]).dot(nrm);
@@ -606,7 +611,11 @@ std::size_t ShellCoupling::guard(Particles& P, const Shells& shells, const Perio
     }
   });
   std::size_t count = 0;
-  for (const uint8_t m : moved) count += m;
+  for (std::size_t r = 0; r < moved.size(); ++r)
+    if (moved[r]) {
+      ++count;
+      put_backs_.push_back(put_back_scratch_[r]);
+    }
   crossings_ += static_cast<long>(count);
   for (const uint8_t m : disagree) disagreements_ += m;
   return count;

@@ -115,6 +115,17 @@ class ShellCoupling {
   }
   long crossings() const { return crossings_; }
   void set_crossings(long c) { crossings_ = c; }
+  // The put-backs of the last guard() call, in band order (deterministic): which fluid particle, where it
+  // was found (over the sheet), the shell body, how far over [m] and whether the sheet's triangles (true) or
+  // the nearest particle's tangent plane (false: beyond the sheet's outline, in a hole of it) decided.
+  struct PutBack {
+    uint32_t id = 0;
+    Vec3 x = Vec3::Zero();
+    uint16_t body = 0;
+    double depth = 0.0;
+    bool sheet = false;
+  };
+  const std::vector<PutBack>& last_put_backs() const { return put_backs_; }
   // Particles the guard found on the wrong side deeper than the step could have taken them (see above).
   long label_disagreements() const { return disagreements_; }
   void set_label_disagreements(long c) { disagreements_ = c; }
@@ -212,6 +223,8 @@ class ShellCoupling {
   long crossings_ = 0;
   long disagreements_ = 0;
   std::size_t masked_ = 0;
+  std::vector<PutBack> put_back_scratch_;  // by band row, written where the guard moves the row
+  std::vector<PutBack> put_backs_;
 };
 
 }  // namespace aortasph
