@@ -448,7 +448,8 @@ class Loader {
         keys = {"type", "density"};
       else if (type == "shell")
         keys = {"type",      "density", "youngs_modulus", "poisson_ratio",
-                "thickness", "model",   "damping",        "hourglass"};
+                "thickness", "model",   "damping",        "hourglass",
+                "c1",        "c2"};
       Obj o(it.value(), path, keys, allowed);
       o.choice("type", {"fluid", "elastic", "rigid", "wall", "shell"});
       if (type == "fluid") {
@@ -548,13 +549,22 @@ class Loader {
     m.density = o.positive("density");
     m.youngs_modulus = o.positive("youngs_modulus");
     if (!o.has("model")) j["model"] = "saint_venant_kirchhoff";
-    m.neo_hookean = o.choice("model", {"saint_venant_kirchhoff", "neo_hookean"}) == "neo_hookean";
+    const std::string model = o.choice("model", {"saint_venant_kirchhoff", "neo_hookean", "lee_sacks"});
+    m.neo_hookean = model != "saint_venant_kirchhoff";  // lee_sacks: neo-Hookean plus an exponential term
+    if (model == "lee_sacks") {
+      m.lee_sacks_c1 = o.positive("c1");
+      m.lee_sacks_c2 = o.positive("c2");
+    } else {
+      for (const char* key : {"c1", "c2"})
+        if (o.has(key))
+          fail(o.path(key), "only the lee_sacks model takes c1 and c2 (model is " + model + ")");
+    }
     m.poisson_ratio = o.number("poisson_ratio");
     if (m.neo_hookean) {
       if (!(m.poisson_ratio >= 0.45 && m.poisson_ratio <= 0.5))
-        fail(o.path("poisson_ratio"),
-             "the neo_hookean shell is incompressible: expected 0.45..0.5 (it uses 0.5), got " +
-                 json(m.poisson_ratio).dump());
+        fail(o.path("poisson_ratio"), "the " + model +
+                                          " shell is incompressible: expected 0.45..0.5 (it uses 0.5), got " +
+                                          json(m.poisson_ratio).dump());
     } else if (!(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5)) {
       fail(o.path("poisson_ratio"), "must lie in (-1, 0.5), got " + json(m.poisson_ratio).dump());
     }

@@ -73,6 +73,10 @@ struct Material {
   // neo_hookean as above (plane stress), hourglass its own default (see the loader).
   double thickness = 0.0;      // [m]
   double shell_damping = 0.0;  // mass-proportional damping of velocity and spin [1/s]
+  // model "lee_sacks" (incompressible, as neo_hookean, which it extends): the exponential term
+  // c1/2 (exp(c2 (I1 - 3)^2) - 1) of the isotropic Lee-Sacks form (sim/solid/shell_material.hpp); 0: none.
+  double lee_sacks_c1 = 0.0;  // [Pa]
+  double lee_sacks_c2 = 0.0;  // [-]
 };
 
 enum class ShapeKind {

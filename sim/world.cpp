@@ -944,6 +944,10 @@ void World::save_state(StateWriter& out) const {
   SectionWriter& sh = out.section("shells", 1);
   sh.array(shells_.directors());
   sh.array(shells_.omegas());
+  if (shells_.stiffens()) {  // a section of its own: only stiffening (Lee-Sacks) shells have it
+    SectionWriter& sf = out.section("shell_stiffening", 1);
+    sf.array(shells_.stiffening());
+  }
 
   if (!shells_.empty()) {  // shell sub-cycling (step_shells): a section of its own, older checkpoints lack it
     SectionWriter& ss = out.section("shell_subcycle", 1);
@@ -1063,6 +1067,14 @@ void World::load_state(const StateReader& in) {
     sh.array(shells_.omegas(), "shell angular velocities", shells_.size());
     sh.done();
   }
+  // The stiffening of the last sub-step's update (at the positions it started from): set after the update
+  // below, which measures it at the stored positions.
+  std::vector<double> stiffening;
+  if (in.has("shell_stiffening")) {
+    SectionReader sf = in.section("shell_stiffening");
+    sf.array(stiffening, "shell stiffening", shells_.size());
+    sf.done();
+  }
   sub_ = ShellSubcycle{};  // without the section: rebuilt from P.v at the next step
   if (in.has("shell_subcycle")) {
     SectionReader ss = in.section("shell_subcycle");
@@ -1133,6 +1145,7 @@ void World::load_state(const StateReader& in) {
   if (!shells_.empty()) {
     shells_.reindex(P_);
     shells_.update(P_);
+    if (!stiffening.empty()) shells_.stiffening() = stiffening;
   }
 }
 

@@ -651,6 +651,23 @@ TEST_CASE("shell: bad input exits 2 naming the key", "[shell][bad-input]") {
       {"shell shape with an elastic material",
        replaced(good, "\"material\": \"sheet\"", "\"material\": \"rubber\""),
        "bodies[0].material: a shell shape (rectangle, disc, cylindrical_panel) needs a shell material"},
+      {"lee_sacks without c1",
+       replaced(good, "\"poisson_ratio\": 0.3, \"thickness\": 0.01",
+                "\"poisson_ratio\": 0.5, \"thickness\": 0.01, \"model\": \"lee_sacks\", \"c2\": 20"),
+       "materials.sheet.c1: missing"},
+      {"lee_sacks with c2 0",
+       replaced(
+           good, "\"poisson_ratio\": 0.3, \"thickness\": 0.01",
+           "\"poisson_ratio\": 0.5, \"thickness\": 0.01, \"model\": \"lee_sacks\", \"c1\": 1e4, \"c2\": 0"),
+       "materials.sheet.c2: must be positive"},
+      {"c1 on a neo_hookean shell",
+       replaced(good, "\"poisson_ratio\": 0.3, \"thickness\": 0.01",
+                "\"poisson_ratio\": 0.5, \"thickness\": 0.01, \"model\": \"neo_hookean\", \"c1\": 1e4"),
+       "materials.sheet.c1: only the lee_sacks model takes c1 and c2 (model is neo_hookean)"},
+      {"lee_sacks compressible",
+       replaced(good, "\"thickness\": 0.01",
+                "\"thickness\": 0.01, \"model\": \"lee_sacks\", \"c1\": 1e4, \"c2\": 20"),
+       "materials.sheet.poisson_ratio: the lee_sacks shell is incompressible"},
       {"displacement probe of an unknown body",
        replaced(good, "\"body\": \"strip\", \"point\"", "\"body\": \"stripe\", \"point\""),
        "probes[0].body: unknown body 'stripe'"},
@@ -684,6 +701,135 @@ TEST_CASE("shell: bad input exits 2 naming the key", "[shell][bad-input]") {
   { std::ofstream(dir / "out" / "shell_putbacks.csv", std::ios::app) << before << after << "0.0001,9,0"; }
   CHECK(run_cli("resume " + (dir / "out").string() + " --end-time 0.0003 --quiet", err) == 0);
   CHECK(slurp(dir / "out" / "shell_putbacks.csv") == header + before);
+}
+
+TEST_CASE("shell lee_sacks: the stress of the closed forms, the energy's derivative and the stiffening bound",
+          "[shell]") {
+  // Incompressible plane stress, psi = mu/2 x + c1/2 (exp(c2 x^2) - 1), x = I1 - 3, mu = E / 3.
+  Material m = shell_sheet(3e5, 0.5, 1e-3, 1100.0);
+  m.neo_hookean = true;
+  m.lee_sacks_c1 = 1e4;
+  m.lee_sacks_c2 = 20.0;
+  const ShellParams p(m);
+  const double mu = 1e5, c1 = 1e4, c2 = 20.0;
+  auto W1 = [&](double x) { return 0.5 * mu + c1 * c2 * x * std::exp(c2 * x * x); };
+  auto stress = [&](const Mat3& E, double* stiff = nullptr) {
+    Mat3 S;
+    double psi = 0.0;
+    shell_stress(p, E, S, psi, stiff);
+    return std::pair{S, psi};
+  };
+  auto green = [](double l1, double l2) {
+    Mat3 E = Mat3::Zero();
+    E(0, 0) = 0.5 * (l1 * l1 - 1.0);
+    E(1, 1) = 0.5 * (l2 * l2 - 1.0);
+    return E;
+  };
+  double prev_eq = 1.0, prev_uni = 1.0, tangent0_eq = 0.0, tangent0_uni = 0.0;
+  const double dl = 1e-6;
+  for (double l = 1.0; l <= 1.25 + 1e-12; l += 0.025) {
+    // Equibiaxial stretch l: lambda3 = 1 / l^2, Cauchy sigma = 2 W1 (l^2 - l^-4), x = 2 l^2 + l^-4 - 3.
+    const double xe = 2 * l * l + std::pow(l, -4) - 3.0;
+    double se = 1.0;
+    const auto [Se, psie] = stress(green(l, l), &se);
+    CHECK(l * l * Se(0, 0) == Approx(2 * W1(xe) * (l * l - std::pow(l, -4))).margin(1e-6));
+    CHECK(Se(1, 1) == Approx(Se(0, 0)).epsilon(1e-12));
+    CHECK(psie == Approx(0.5 * mu * xe + 0.5 * c1 * (std::exp(c2 * xe * xe) - 1.0)).margin(1e-9));
+    // Uniaxial stretch l: lambda2 = lambda3 = l^-1/2, S22 = 0, sigma = 2 W1 (l^2 - 1 / l), x = l^2 + 2 / l
+    // - 3.
+    const double xu = l * l + 2.0 / l - 3.0;
+    double su = 1.0;
+    const auto [Su, psiu] = stress(green(l, 1.0 / std::sqrt(l)), &su);
+    CHECK(l * l * Su(0, 0) == Approx(2 * W1(xu) * (l * l - 1.0 / l)).margin(1e-6));
+    CHECK(std::abs(Su(1, 1)) < 1e-6);
+    // The stiffening bound: 1 unstrained, rising with the stretch and at least the rise of the tangent
+    // d sigma / d lambda over its value at l = 1 (6 mu equibiaxial, 3 mu uniaxial), which sets the wave
+    // speed.
+    auto sig_eq = [&](double s) {
+      const double x = 2 * s * s + std::pow(s, -4) - 3.0;
+      return 2 * W1(x) * (s * s - std::pow(s, -4));
+    };
+    auto sig_uni = [&](double s) {
+      const double x = s * s + 2.0 / s - 3.0;
+      return 2 * W1(x) * (s * s - 1.0 / s);
+    };
+    const double te = (sig_eq(l + dl) - sig_eq(l > 1.0 ? l - dl : l)) / (l > 1.0 ? 2 * dl : dl);
+    const double tu = (sig_uni(l + dl) - sig_uni(l > 1.0 ? l - dl : l)) / (l > 1.0 ? 2 * dl : dl);
+    if (l == 1.0) {
+      tangent0_eq = te, tangent0_uni = tu;
+      CHECK(te == Approx(6 * mu).epsilon(1e-4));
+      CHECK(tu == Approx(3 * mu).epsilon(1e-4));
+      CHECK(se == 1.0);
+      CHECK(su == 1.0);
+    } else {
+      CHECK(se > prev_eq);
+      CHECK(su > prev_uni);
+    }
+    INFO("stretch " << l << ": stiffening " << se << " / " << su << ", tangent rise " << te / tangent0_eq
+                    << " / " << tu / tangent0_uni);
+    CHECK(se >= te / tangent0_eq);
+    CHECK(su >= tu / tangent0_uni);
+    // and not far above it (a step many times too short would cost the run for nothing)
+    CHECK(se <= 4.0 * te / tangent0_eq);
+    CHECK(su <= 4.0 * tu / tangent0_uni);
+    prev_eq = se, prev_uni = su;
+  }
+  // The energy's derivative is the stress, for a general strain (shear included).
+  Mat3 E = green(1.12, 0.97);
+  E(0, 1) = E(1, 0) = 0.04;
+  const auto [S, psi] = stress(E);
+  for (const auto& [a, b] : {std::pair{0, 0}, {1, 1}, {0, 1}}) {
+    Mat3 Ep = E, Em = E;
+    const double h = 1e-7, k = a == b ? 1.0 : 0.5;  // an off-diagonal component appears twice
+    Ep(a, b) += k * h, Ep(b, a) = Ep(a, b);
+    Em(a, b) -= k * h, Em(b, a) = Em(a, b);
+    CHECK((stress(Ep).second - stress(Em).second) / (2 * h) == Approx(S(a, b)).epsilon(1e-5));
+  }
+  // c1 = 0 is the neo-Hookean law, bit for bit.
+  Material nh = m;
+  nh.lee_sacks_c1 = nh.lee_sacks_c2 = 0.0;
+  Mat3 Snh, Sls;
+  double pnh = 0.0, pls = 0.0;
+  Material z = m;
+  z.lee_sacks_c1 = 0.0;
+  shell_stress(ShellParams(nh), E, Snh, pnh);
+  shell_stress(ShellParams(z), E, Sls, pls);
+  CHECK(Snh == Sls);
+  CHECK(pnh == pls);
+}
+
+TEST_CASE("shell lee_sacks: a stiffened plate takes shorter steps and resumes bitwise",
+          "[shell][checkpoint]") {
+  // The plate of the checkpoint test below, of tissue (E = 0.3 MPa, incompressible), under 2 kPa: it
+  // bulges, its membrane stretches and stiffens, and the stable step shrinks with the stiffening; a
+  // checkpoint carries the stiffening, so the resumed run takes the same steps.
+  Scene s = plate_scene(0.5, 0.025, 0.05, 3e5, 0.5, 1000.0, 2e3, 50.0);
+  s.materials[0].neo_hookean = true;
+  Scene ls = s;
+  ls.materials[0].lee_sacks_c1 = 1e4;
+  ls.materials[0].lee_sacks_c2 = 20.0;
+  World nh(s), a(ls);
+  const double dt0 = a.shell_stable_dt();
+  CHECK(dt0 == nh.shell_stable_dt());  // unstrained: the neo-Hookean's step
+  a.advance_to(0.05, [] { return true; });
+  nh.advance_to(0.05, [] { return true; });
+  double most = 1.0;
+  for (double st : a.shells().stiffening()) most = std::max(most, st);
+  INFO("largest stiffening " << most << ", stable step " << a.shell_stable_dt() << " (unstrained " << dt0
+                             << ", neo-Hookean now " << nh.shell_stable_dt() << ")");
+  CHECK(most > 1.5);
+  // The wave and shear-rotary limits scale with 1 / sqrt(stiffening) (the speed and the other limits only
+  // shorten it further).
+  CHECK(a.shell_stable_dt() <= dt0 / std::sqrt(most) * (1.0 + 1e-9));
+  StateWriter out;
+  a.save_state(out);
+  const StateReader in(out.bytes());
+  World b(ls);
+  b.load_state(in);
+  a.advance_to(0.06, [] { return true; });
+  b.advance_to(0.06, [] { return true; });
+  CHECK(state_hash(a) == state_hash(b));
+  CHECK(a.steps() == b.steps());
 }
 
 TEST_CASE("shell: a checkpoint resumes bitwise (directors and spin included)", "[shell][checkpoint]") {

@@ -226,6 +226,7 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
   energy_.assign(n, 0.0);
   vm_.assign(n, 0.0);
   strain_.assign(n, 0.0);
+  stiffening_.assign(n, 1.0);
   Nres_.assign(n, Mat2::Zero());
   Mres_.assign(n, Mat2::Zero());
   Qres_.assign(n, Eigen::Vector2d::Zero());
@@ -264,7 +265,7 @@ void Shells::update(const Particles& P) {
     Q0 << T1_[s], T2_[s], N_[s];
     Mat32 PG = Mat32::Zero(), PH = Mat32::Zero();
     Vec3 q = Vec3::Zero();
-    double U = 0.0, vm = 0.0, strain = -1e300;
+    double U = 0.0, vm = 0.0, strain = -1e300, stiff = 1.0;
     Mat2 Nr = Mat2::Zero(), Mr = Mat2::Zero();
     Eigen::Vector2d Qr = Eigen::Vector2d::Zero();
     // The membrane strain's curvature correction (docs/model.md "Shells", membrane locking): the linear
@@ -293,8 +294,9 @@ void Shells::update(const Particles& P) {
       Mat3 El = Q0.transpose() * Eg * Q0;
       El.topLeftCorner<2, 2>() -= Csym;
       Mat3 Sl;
-      double psi = 0.0;
-      shell_stress(sp, El, Sl, psi);
+      double psi = 0.0, st = 1.0;
+      shell_stress(sp, El, Sl, psi, sp.c1 > 0.0 ? &st : nullptr);
+      stiff = std::max(stiff, st);
       const double V = vol_[kGauss * s + k];
       U += V * psi;
       Nt += V * Sl.topLeftCorner<2, 2>();
@@ -340,6 +342,7 @@ void Shells::update(const Particles& P) {
     energy_[s] = U;
     vm_[s] = vm;
     strain_[s] = strain;
+    stiffening_[s] = stiff;
     Nres_[s] = Nr;
     Mres_[s] = Mr;
     Qres_[s] = Qr;
@@ -434,18 +437,24 @@ void Shells::advance_directors(double dt, double kick) {
 }
 
 double Shells::stable_dt(double cfl, double max_speed) const {
+  // A stiffening law (Lee-Sacks) raises the wave speed with the strain: c_plate times the square root of
+  // the largest stiffening of its particles at the last update() (1 for the other laws, and before any).
+  std::vector<double> stiff(params_.size(), 1.0);
+  for (std::size_t s = 0; s < stiffening_.size(); ++s)
+    stiff[material_[s]] = std::max(stiff[material_[s]], stiffening_[s]);
   double dt = std::numeric_limits<double>::max();
   for (std::size_t m = 0; m < params_.size(); ++m) {
     const ShellParams& p = params_[m];
     if (p.t <= 0.0) continue;
     const double h = h_;
+    const double c = stiff[m] > 1.0 ? p.c_plate * std::sqrt(stiff[m]) : p.c_plate;
     // Wu et al. 2023 / SPHinXsys ShellAcousticTimeStepSize: the in-plane wave crossing h, and the shear-
     // rotary (Mindlin) limit, which goes like t / c for h >> t.
     const double pi2 = std::numbers::pi * std::numbers::pi;
     const double rotary =
-        h * std::sqrt(1.0 / (p.c_plate * p.c_plate) /
-                      (2.0 + pi2 / 12.0 * (1.0 - p.nu) * (1.0 + 1.5 * (h / p.t) * (h / p.t))));
-    dt = std::min(dt, cfl * std::min(h / (p.c_plate + max_speed), rotary));
+        h *
+        std::sqrt(1.0 / (c * c) / (2.0 + pi2 / 12.0 * (1.0 - p.nu) * (1.0 + 1.5 * (h / p.t) * (h / p.t))));
+    dt = std::min(dt, cfl * std::min(h / (c + max_speed), rotary));
   }
   return dt;
 }

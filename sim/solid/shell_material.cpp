@@ -1,5 +1,6 @@
 #include "solid/shell_material.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 
@@ -16,9 +17,11 @@ ShellParams::ShellParams(const Material& m)
       c_plate(std::sqrt(m.youngs_modulus / (m.density * (1.0 - nu * nu)))),
       damping(m.shell_damping),
       hourglass(m.hourglass),
-      neo_hookean(m.neo_hookean) {}
+      neo_hookean(m.neo_hookean),
+      c1(m.lee_sacks_c1),
+      c2(m.lee_sacks_c2) {}
 
-void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi) {
+void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi, double* stiffening) {
   S.setZero();
   const double ks = p.kappa * 2.0 * p.mu;  // transverse shear, S_a3 = kappa 2 mu E_a3
   S(0, 2) = S(2, 0) = ks * E(0, 2);
@@ -36,9 +39,25 @@ void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi) {
   Eigen::Matrix2d C = Eigen::Matrix2d::Identity() + 2.0 * E.topLeftCorner<2, 2>();
   const double det = std::max(C.determinant(), 1e-6);
   const Eigen::Matrix2d Cinv = C.inverse();
-  const Eigen::Matrix2d S2 = p.mu * (Eigen::Matrix2d::Identity() - Cinv / det);
-  S.topLeftCorner<2, 2>() = S2;
-  psi += 0.5 * p.mu * (C.trace() + 1.0 / det - 3.0);
+  const Eigen::Matrix2d g = Eigen::Matrix2d::Identity() - Cinv / det;  // dI1/dC (in plane)
+  const double x = C.trace() + 1.0 / det - 3.0;                        // I1 - 3
+  if (p.c1 <= 0.0) {
+    S.topLeftCorner<2, 2>() = p.mu * g;
+    psi += 0.5 * p.mu * x;
+    return;
+  }
+  // Lee-Sacks (isotropic): W1 = mu/2 + c1 c2 x exp(c2 x^2), S = 2 W1 g.
+  const double e = std::exp(p.c2 * x * x);
+  const double W1 = 0.5 * p.mu + p.c1 * p.c2 * x * e;
+  S.topLeftCorner<2, 2>() = 2.0 * W1 * g;
+  psi += 0.5 * p.mu * x + 0.5 * p.c1 * (e - 1.0);
+  if (stiffening) {
+    const double W11 = p.c1 * p.c2 * (1.0 + 2.0 * p.c2 * x * x) * e;
+    // The material part (W1, W11) times the geometric one: the largest squared stretch in the plane.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(C, Eigen::EigenvaluesOnly);
+    const double stretch2 = std::max(1.0, eig.eigenvalues().maxCoeff());
+    *stiffening = std::max(1.0, stretch2 * (2.0 * W1 + 2.0 * W11 * g.squaredNorm()) / p.mu);
+  }
 }
 
 }  // namespace aortasph

@@ -9,6 +9,13 @@
 //     the membrane form): lambda3^2 = 1 / det C2 with C2 the in-plane 2x2 block of C = I + 2E; psi = mu/2
 //     (tr C2 + 1 / det C2 - 3), S_ab = mu (delta_ab - C2^-1_ab / det C2); mu = E / 3 (the small-strain
 //     Young's modulus is E); transverse shear as above, linear in E_a3 with kappa 2 mu.
+//   - Lee-Sacks, isotropic: the member delta = 1 (no fibre term) of the Lee-Sacks form W = c0/2 (I1 - 3) +
+//     c1/2 (delta exp(c2 (I1 - 3)^2) + (1 - delta) exp(c3 (I4 - 1)^2) - 1), the Fung-type law Hsu et al. 2015
+//     (Comput. Mech. 55:1211) used for valve leaflets (as the project's reference sheet valve-physiology.md,
+//     section 4, quotes it; Lee, Sacks et al. 2014 is its origin, not re-read here), incompressible
+//     in plane stress as the neo-Hookean above with c0 = mu = E / 3: psi = mu/2 x + c1/2 (exp(c2 x^2) - 1),
+//     x = I1 - 3 = tr C2 + 1 / det C2 - 3; S_ab = 2 W1 (delta_ab - C2^-1_ab / det C2), W1 = dpsi/dI1 = mu/2 +
+//     c1 c2 x exp(c2 x^2). Soft at small strain (E), it stiffens as collagen does: c1, c2 set where.
 #pragma once
 
 #include <Eigen/Dense>
@@ -30,11 +37,15 @@ struct ShellParams {
   double damping = 0.0;  // [1/s]
   double hourglass = 0.0;
   bool neo_hookean = false;
+  double c1 = 0.0, c2 = 0.0;  // Lee-Sacks exponential term (0: none)
   ShellParams() = default;
   explicit ShellParams(const Material& m);
 };
 
-// S (local frame, symmetric, S33 = 0) and psi for a local Green-Lagrange strain E (E33 ignored).
-void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi);
+// S (local frame, symmetric, S33 = 0) and psi for a local Green-Lagrange strain E (E33 ignored). With
+// stiffening (Lee-Sacks only), an upper estimate of the in-plane tangent stiffness over its small-strain
+// value: lambda_max^2 (2 W1 + 2 W11 |dI1/dC|^2) / mu with W11 = d2psi/dI1^2 and lambda_max^2 the largest
+// eigenvalue of C2 (1 at no strain; the wave speed grows with its square root, Shells::stable_dt).
+void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi, double* stiffening = nullptr);
 
 }  // namespace aortasph
