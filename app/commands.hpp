@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,6 +32,9 @@ struct ResumeOptions {
 
 int cmd_run(const RunOptions& options);
 int cmd_resume(const ResumeOptions& options);
+// resume: the scene as this program resolves it (now), less the keys the recorded resolution lacks (keys
+// added since, at defaults that keep the older behaviour), for comparing with what the checkpoint recorded.
+nlohmann::json pruned_to(const nlohmann::json& now, const nlohmann::json& recorded);
 int cmd_check(const std::filesystem::path& scene, const std::vector<std::string>& sets);
 // aortasph bench [--threads N] [--quick] [--render] [--json FILE] [--case NAME | --scene FILE]
 //                [--set KEY=VALUE]... [--steps N]

@@ -235,6 +235,25 @@ RunOptions parse_run_options(const std::vector<std::string>& args) {
   return o;
 }
 
+// The scene as this program resolves it, less the keys the recorded resolution lacks: keys a later program
+// added, which it fills with defaults that keep the older program's behaviour (a new key's default must: a
+// cycle metric may read differently, the simulation may not). Objects keep the recorded keys only; arrays of
+// the recorded length are pruned element by element; anything else is compared as it is.
+nlohmann::json pruned_to(const nlohmann::json& now, const nlohmann::json& recorded) {
+  if (now.is_object() && recorded.is_object()) {
+    nlohmann::json out = nlohmann::json::object();
+    for (auto it = now.begin(); it != now.end(); ++it)
+      if (recorded.contains(it.key())) out[it.key()] = pruned_to(it.value(), recorded[it.key()]);
+    return out;
+  }
+  if (now.is_array() && recorded.is_array() && now.size() == recorded.size()) {
+    nlohmann::json out = nlohmann::json::array();
+    for (std::size_t k = 0; k < now.size(); ++k) out.push_back(pruned_to(now[k], recorded[k]));
+    return out;
+  }
+  return now;
+}
+
 namespace {
 
 constexpr const char* kCheckpointFile = "checkpoint.bin";
@@ -694,7 +713,10 @@ int cmd_resume(const ResumeOptions& ro) {
     loaded.scene.t_end = record.end_override;
     loaded.resolved["time"]["end"] = record.end_override;
   }
-  if (scene_hash(loaded.resolved) != record.hash)
+  // The same values as when it ran; keys this program added since are left out of the comparison
+  // (pruned_to): a run of an older program resumes with them at their defaults.
+  if (scene_hash(loaded.resolved) != record.hash &&
+      scene_hash(pruned_to(loaded.resolved, resolved)) != record.hash)
     throw InputError(file.string() + ": the recorded scene no longer resolves to the same values with this " +
                      "program; cannot resume");
   RunOptions o;
