@@ -15,6 +15,20 @@ std::string format_number(double v) {
   return buf;
 }
 
+void replace_file(const std::filesystem::path& path, const std::string& text) {
+  std::filesystem::path tmp = path;
+  tmp += ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    f << text;
+    f.close();
+    if (!f) throw InputError(tmp.string() + ": write failed (disk full?)");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw InputError(path.string() + ": cannot replace: " + ec.message());
+}
+
 CsvWriter::CsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns)
     : path_(path), out_(path, std::ios::trunc) {
   if (!out_) throw InputError(path.string() + ": cannot open for writing");
@@ -45,18 +59,7 @@ CsvWriter::CsvWriter(const std::filesystem::path& path, const std::vector<std::s
     throw InputError(path.string() + ": has " + std::to_string(rows) +
                      " complete rows, the checkpoint needs " + std::to_string(keep_rows) + "; cannot resume");
   in.close();
-  // Rewritten through a temporary file, so a kill now leaves the old or the new file, never a shorter one.
-  std::filesystem::path tmp = path;
-  tmp += ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    f << kept;
-    f.close();
-    if (!f) throw InputError(tmp.string() + ": write failed (disk full?)");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw InputError(path.string() + ": cannot replace: " + ec.message());
+  replace_file(path, kept);
   out_.open(path, std::ios::binary | std::ios::app);
   if (!out_) throw InputError(path.string() + ": cannot open for writing");
 }

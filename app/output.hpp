@@ -47,4 +47,8 @@ class VtkWriter {
 
 std::string format_number(double v);
 
+// Writes text to path through a temporary file renamed over it, so that a kill leaves the old or the new
+// file, never a shorter one. Throws InputError when it cannot.
+void replace_file(const std::filesystem::path& path, const std::string& text);
+
 }  // namespace aortasph

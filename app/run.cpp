@@ -147,17 +147,7 @@ std::ofstream open_put_backs(const std::filesystem::path& file, double keep_unti
       while (std::getline(in, line) && !in.eof())
         if (std::strtod(line.c_str(), nullptr) <= keep_until * (1.0 + 1e-12)) kept += line + "\n";
   }
-  std::filesystem::path tmp = file;
-  tmp += ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    f << kept;
-    f.close();
-    if (!f) throw InputError(tmp.string() + ": write failed (disk full?)");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) throw InputError(file.string() + ": cannot replace: " + ec.message());
+  replace_file(file, kept);
   std::ofstream out(file, std::ios::binary | std::ios::app);
   if (!out) throw InputError(file.string() + ": cannot open for writing");
   return out;

@@ -177,15 +177,7 @@ class PointGrid {
   // min(cap, the distance from x to the nearest point); cap <= cell.
   double nearest(const Vec3& x, double cap) const {
     double best2 = cap * cap;
-    const std::array<long, 3> c = cell_of(x);
-    for (long dx = -1; dx <= 1; ++dx)
-      for (long dy = -1; dy <= 1; ++dy)
-        for (long dz = -1; dz <= 1; ++dz) {
-          const uint64_t k = key({c[0] + dx, c[1] + dy, c[2] + dz});
-          auto it = std::lower_bound(keys_.begin(), keys_.end(), std::pair<uint64_t, std::size_t>(k, 0));
-          for (; it != keys_.end() && it->first == k; ++it)
-            best2 = std::min(best2, (pts_[it->second] - x).squaredNorm());
-        }
+    for_each_near(x, [&](std::size_t k) { best2 = std::min(best2, (pts_[k] - x).squaredNorm()); });
     return std::sqrt(best2);
   }
   // Calls f(k) for every point k closer to x than r (r <= cell), in a fixed order (the 27 cells around x,
@@ -193,18 +185,24 @@ class PointGrid {
   template <class F>
   void for_each_within(const Vec3& x, double r, F&& f) const {
     const double r2 = r * r;
+    for_each_near(x, [&](std::size_t k) {
+      if ((pts_[k] - x).squaredNorm() < r2) f(k);
+    });
+  }
+
+ private:
+  // Calls f(k) for every point k of the 27 cells around x's, cells in a fixed order.
+  template <class F>
+  void for_each_near(const Vec3& x, F&& f) const {
     const std::array<long, 3> c = cell_of(x);
     for (long dx = -1; dx <= 1; ++dx)
       for (long dy = -1; dy <= 1; ++dy)
         for (long dz = -1; dz <= 1; ++dz) {
           const uint64_t k = key({c[0] + dx, c[1] + dy, c[2] + dz});
           auto it = std::lower_bound(keys_.begin(), keys_.end(), std::pair<uint64_t, std::size_t>(k, 0));
-          for (; it != keys_.end() && it->first == k; ++it)
-            if ((pts_[it->second] - x).squaredNorm() < r2) f(it->second);
+          for (; it != keys_.end() && it->first == k; ++it) f(it->second);
         }
   }
-
- private:
   std::array<long, 3> cell_of(const Vec3& x) const {
     return {static_cast<long>(std::floor(x.x() / cell_)), static_cast<long>(std::floor(x.y() / cell_)),
             static_cast<long>(std::floor(x.z() / cell_))};
