@@ -381,11 +381,7 @@ std::string find_python() {
 
 }  // namespace
 
-int make_wiggers_plot(const fs::path& dir, std::string& error) {
-  return make_wiggers_plot(dir, false, error);
-}
-
-int make_wiggers_plot(const fs::path& dir, bool remeasure, std::string& error) {
+int make_wiggers_plot(const fs::path& dir, std::string& error, bool remeasure) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) {
     error = dir.string() + ": no such folder";
@@ -454,10 +450,7 @@ int make_wiggers_plot(const fs::path& dir, bool remeasure, std::string& error) {
           cycle_metrics_of(scene, table, diagnostics ? &*diagnostics : nullptr);
       write_cycles_csv(cycles, measured, scene);
       j["cycles"] = cycles_json(scene, measured);
-      std::ofstream out(run_json, std::ios::trunc);
-      out << j.dump(2) << "\n";
-      out.close();
-      if (!out) throw InputError(run_json.string() + ": write failed (disk full?)");
+      replace_file(run_json, j.dump(2) + "\n");
       for (const CycleMetrics& m : measured) std::printf("aortasph: %s\n", cycle_line(m).c_str());
       std::fflush(stdout);
     }
@@ -509,7 +502,7 @@ int cmd_plot(const std::vector<std::string>& args) {
     return 2;
   }
   std::string error;
-  const int rc = make_wiggers_plot(dirs[0], remeasure, error);
+  const int rc = make_wiggers_plot(dirs[0], error, remeasure);
   if (rc != 0) {
     std::fprintf(stderr, "aortasph plot: error: %s\n", error.c_str());
     return rc;

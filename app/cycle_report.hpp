@@ -48,13 +48,12 @@ nlohmann::json cycles_json(const Scene& scene, const std::vector<CycleMetrics>& 
 std::string cycle_line(const CycleMetrics& m);
 
 // Draws OUT_DIR/figures/wiggers.png with scripts/plot_wiggers.py (embedded); returns 0, or 2 with a message
-// in `error` (a missing folder or column, no python3 with matplotlib, the script failing).
-int make_wiggers_plot(const std::filesystem::path& dir, std::string& error);
-// The same, with remeasure: first the cycles measured again from probes.csv (and diagnostics.csv) with this
-// program's metric definitions and the scene run.json records, cycles.csv and run.json's "cycles" rewritten,
-// each cycle's line printed (`aortasph plot OUT_DIR --remeasure`: a finished run brought up to date after a
-// definition changed, without running it again).
-int make_wiggers_plot(const std::filesystem::path& dir, bool remeasure, std::string& error);
+// in `error` (a missing folder or column, no python3 with matplotlib, the script failing). With remeasure,
+// first the cycles measured again from probes.csv (and diagnostics.csv) with this program's metric
+// definitions and the scene run.json records, cycles.csv and run.json's "cycles" rewritten, each cycle's line
+// printed (`aortasph plot OUT_DIR --remeasure`: a finished run brought up to date after a definition changed,
+// without running it again).
+int make_wiggers_plot(const std::filesystem::path& dir, std::string& error, bool remeasure = false);
 
 // aortasph plot OUT_DIR
 int cmd_plot(const std::vector<std::string>& args);

@@ -744,9 +744,7 @@ std::vector<double> ProbeSet::measure(const World& world) const {
         const double best = parallel_reduce(
             n, -1.0,
             [&](std::size_t i) {
-              if (P.kind[i] != Kind::Fluid || (!pr.bodies.empty() && !in_set[P.body[i]]) ||
-                  (pr.region && !pr.region->contains(P.x[i])))
-                return -1.0;
+              if (!counted(i) || (pr.region && !pr.region->contains(P.x[i]))) return -1.0;
               return P.v[i].norm();
             },
             [](double a, double b) { return std::max(a, b); });

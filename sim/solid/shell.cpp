@@ -72,6 +72,7 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
   params_.resize(materials.size());
   for (std::size_t m = 0; m < materials.size(); ++m)
     if (materials[m].type == MaterialType::Shell) params_[m] = ShellParams(materials[m]);
+  for (const ShellParams& p : params_) stiffens_ = stiffens_ || p.c1 > 0.0;
   uint32_t max_id = 0;
   for (std::size_t i = 0; i < P.size(); ++i) max_id = std::max(max_id, P.id[i]);
   s_of_id_.assign(P.size() == 0 ? 0 : max_id + 1, kNone);
@@ -440,8 +441,9 @@ double Shells::stable_dt(double cfl, double max_speed) const {
   // A stiffening law (Lee-Sacks) raises the wave speed with the strain: c_plate times the square root of
   // the largest stiffening of its particles at the last update() (1 for the other laws, and before any).
   std::vector<double> stiff(params_.size(), 1.0);
-  for (std::size_t s = 0; s < stiffening_.size(); ++s)
-    stiff[material_[s]] = std::max(stiff[material_[s]], stiffening_[s]);
+  if (stiffens_)
+    for (std::size_t s = 0; s < stiffening_.size(); ++s)
+      stiff[material_[s]] = std::max(stiff[material_[s]], stiffening_[s]);
   double dt = std::numeric_limits<double>::max();
   for (std::size_t m = 0; m < params_.size(); ++m) {
     const ShellParams& p = params_[m];

@@ -157,11 +157,7 @@ class Shells {
   // saved so that a resumed run takes the steps the uninterrupted one took; whether any material stiffens.
   std::vector<double>& stiffening() { return stiffening_; }
   const std::vector<double>& stiffening() const { return stiffening_; }
-  bool stiffens() const {
-    for (const ShellParams& p : params_)
-      if (p.c1 > 0.0) return true;
-    return false;
-  }
+  bool stiffens() const { return stiffens_; }
 
   // For tests and validations: set the current director of slot s; an external moment on slot s [N m] (held
   // until changed); a support of slot s (0 free, 1 fixed, 2 pinned, 3 a diaphragm: the position held in the
@@ -223,6 +219,7 @@ class Shells {
   std::vector<Mat3> F0_;
   std::vector<double> energy_, vm_, strain_;
   std::vector<double> stiffening_;  // stiffening laws: the tangent's rise over its small-strain value (>= 1)
+  bool stiffens_ = false;           // a material with a stiffening law (Lee-Sacks c1 > 0)
   std::vector<Mat2> Nres_, Mres_;
   std::vector<Eigen::Vector2d> Qres_;
 };
