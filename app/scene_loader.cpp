@@ -447,9 +447,18 @@ class Loader {
       else if (type == "rigid")
         keys = {"type", "density"};
       else if (type == "shell")
-        keys = {"type",      "density", "youngs_modulus", "poisson_ratio",
-                "thickness", "model",   "damping",        "hourglass",
-                "c1",        "c2"};
+        keys = {"type",
+                "density",
+                "youngs_modulus",
+                "poisson_ratio",
+                "thickness",
+                "model",
+                "damping",
+                "hourglass",
+                "c1",
+                "c2",
+                "c3",
+                "delta"};
       Obj o(it.value(), path, keys, allowed);
       o.choice("type", {"fluid", "elastic", "rigid", "wall", "shell"});
       if (type == "fluid") {
@@ -552,12 +561,17 @@ class Loader {
     const std::string model = o.choice("model", {"saint_venant_kirchhoff", "neo_hookean", "lee_sacks"});
     m.neo_hookean = model != "saint_venant_kirchhoff";  // lee_sacks: neo-Hookean plus an exponential term
     if (model == "lee_sacks") {
+      // delta: the isotropic share (1, the default: no fibre term; 0: fibres only, c2 not used).
+      m.lee_sacks_delta = o.number("delta", 1.0);
+      if (!(m.lee_sacks_delta >= 0.0 && m.lee_sacks_delta <= 1.0))
+        fail(o.path("delta"), "must lie in [0, 1], got " + json(m.lee_sacks_delta).dump());
       m.lee_sacks_c1 = o.positive("c1");
-      m.lee_sacks_c2 = o.positive("c2");
+      if (m.lee_sacks_delta > 0.0 || o.has("c2")) m.lee_sacks_c2 = o.positive("c2");
+      if (m.lee_sacks_delta < 1.0 || o.has("c3")) m.lee_sacks_c3 = o.positive("c3");
     } else {
-      for (const char* key : {"c1", "c2"})
+      for (const char* key : {"c1", "c2", "c3", "delta"})
         if (o.has(key))
-          fail(o.path(key), "only the lee_sacks model takes c1 and c2 (model is " + model + ")");
+          fail(o.path(key), "only the lee_sacks model takes c1, c2, c3 and delta (model is " + model + ")");
     }
     m.poisson_ratio = o.number("poisson_ratio");
     if (m.neo_hookean) {
@@ -596,7 +610,7 @@ class Loader {
   Body body(json& j, const std::string& path, const Scene& s) {
     Obj o(j, path,
           {"name", "material", "shape", "translate", "rotate", "velocity", "angular_velocity", "color",
-           "render", "fixed", "initial_flow", "pinned", "pressure_load", "slip", "jitter"},
+           "render", "fixed", "initial_flow", "pinned", "pressure_load", "slip", "jitter", "fibre_direction"},
           allowed);
     Body b;
     b.name = o.string("name");
@@ -661,8 +675,10 @@ class Loader {
       if (o.has("fixed")) b.shell_fixed = boxes(o, "fixed");
       if (o.has("pinned")) b.shell_pinned = boxes(o, "pinned");
       if (o.has("pressure_load")) b.pressure_load = series(o, "pressure_load", std::nullopt, false);
+      if (o.has("fibre_direction")) b.fibre_direction = o.unit("fibre_direction");
       return b;
     }
+    if (o.has("fibre_direction")) fail(o.path("fibre_direction"), "only shell bodies have a fibre direction");
     if (o.has("pinned")) fail(o.path("pinned"), "only shell bodies can be pinned");
     if (o.has("pressure_load")) fail(o.path("pressure_load"), "only shell bodies carry a pressure_load");
     if (o.has("fixed")) {

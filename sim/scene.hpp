@@ -73,10 +73,13 @@ struct Material {
   // neo_hookean as above (plane stress), hourglass its own default (see the loader).
   double thickness = 0.0;      // [m]
   double shell_damping = 0.0;  // mass-proportional damping of velocity and spin [1/s]
-  // model "lee_sacks" (incompressible, as neo_hookean, which it extends): the exponential term
-  // c1/2 (exp(c2 (I1 - 3)^2) - 1) of the isotropic Lee-Sacks form (sim/solid/shell_material.hpp); 0: none.
-  double lee_sacks_c1 = 0.0;  // [Pa]
-  double lee_sacks_c2 = 0.0;  // [-]
+  // model "lee_sacks" (incompressible, as neo_hookean, which it extends): the exponential terms
+  // c1/2 (delta (exp(c2 (I1 - 3)^2) - 1) + (1 - delta) (exp(c3 (I4 - 1)^2) - 1)) of the Lee-Sacks form
+  // (sim/solid/shell_material.hpp), I4 the squared stretch along the fibre direction; c1 = 0: none.
+  double lee_sacks_c1 = 0.0;     // [Pa]
+  double lee_sacks_c2 = 0.0;     // [-]
+  double lee_sacks_c3 = 0.0;     // [-]
+  double lee_sacks_delta = 1.0;  // [-] 1: isotropic (no fibre term)
 };
 
 enum class ShapeKind {
@@ -226,6 +229,9 @@ struct Body {
   double jitter = 0.0;
   // Shell bodies: supports (each a list of boxes): fixed holds position and director, pinned the position.
   std::vector<Box> shell_fixed, shell_pinned;
+  // Shell bodies: the fibre direction of a Lee-Sacks material with fibres, projected on each particle's
+  // tangent plane (the aortic leaflets take the circumferential direction unless this is given).
+  std::optional<Vec3> fibre_direction;
   std::optional<TimeSeries> pressure_load;  // shell bodies: pressure along the normal [Pa]
   // Wall, rigid and elastic bodies, `"slip": "free_slip"` (issue 20): no viscous shear between the fluid and
   // the body's particles (fluid/fluid_wcsph.cpp); default no slip (Adami et al. 2012, eq. 22).

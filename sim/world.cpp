@@ -608,10 +608,26 @@ void World::add_shell_seeds(const Body& body, const std::string& where, const Sh
                             std::size_t first, std::vector<ShellSeed>& seeds) const {
   seeds.resize(P_.size());
   const std::size_t n = sample.points.size();
+  const Material& mat = scene_.materials.at(body.material);
+  const bool fibred = mat.lee_sacks_c1 > 0.0 && mat.lee_sacks_delta < 1.0;
+  if (body.fibre_direction && !fibred)
+    throw SetupError(where +
+                     ".fibre_direction: the body's material has no fibre term (lee_sacks with delta < 1)");
+  if (fibred && !body.fibre_direction && sample.fibres.empty())
+    throw SetupError(where +
+                     ".fibre_direction: missing (the material's fibre term, lee_sacks with delta < 1, "
+                     "needs a direction; only the aortic leaflets have their own)");
   for (std::size_t k = 0; k < n; ++k) {
     ShellSeed& sd = seeds[first + k];
     sd.normal = sample.normals[k];
     sd.area = sample.areas[k];
+    if (body.fibre_direction)
+      sd.fibre = *body.fibre_direction;
+    else if (!sample.fibres.empty())
+      sd.fibre = sample.fibres[k];
+    if (fibred && (sd.fibre - sd.fibre.dot(sd.normal) * sd.normal).norm() < 1e-3)
+      throw SetupError(where + ".fibre_direction: along the sheet's normal at particle " + std::to_string(k) +
+                       " (the fibres lie in the sheet)");
     if (!sample.pinned.empty() && sample.pinned[k]) sd.support = 2;
     if (!sample.clamped.empty() && sample.clamped[k]) sd.support = 1;
   }

@@ -15,6 +15,7 @@
 #include "cli_helpers.hpp"
 #include "core/parallel.hpp"
 #include "core/sim_errors.hpp"
+#include "geometry/aortic_root.hpp"
 #include "io/probes.hpp"
 #include "scene_loader.hpp"
 #include "solid/shell.hpp"
@@ -663,7 +664,35 @@ TEST_CASE("shell: bad input exits 2 naming the key", "[shell][bad-input]") {
       {"c1 on a neo_hookean shell",
        replaced(good, "\"poisson_ratio\": 0.3, \"thickness\": 0.01",
                 "\"poisson_ratio\": 0.5, \"thickness\": 0.01, \"model\": \"neo_hookean\", \"c1\": 1e4"),
-       "materials.sheet.c1: only the lee_sacks model takes c1 and c2 (model is neo_hookean)"},
+       "materials.sheet.c1: only the lee_sacks model takes c1, c2, c3 and delta (model is neo_hookean)"},
+      {"lee_sacks delta above 1",
+       replaced(good, "\"poisson_ratio\": 0.3, \"thickness\": 0.01",
+                "\"poisson_ratio\": 0.5, \"thickness\": 0.01, \"model\": \"lee_sacks\", \"c1\": 1e5, "
+                "\"c2\": 20, \"c3\": 5, \"delta\": 1.5"),
+       "materials.sheet.delta: must lie in [0, 1], got 1.5"},
+      {"lee_sacks fibres without c3",
+       replaced(good, "\"poisson_ratio\": 0.3, \"thickness\": 0.01",
+                "\"poisson_ratio\": 0.5, \"thickness\": 0.01, \"model\": \"lee_sacks\", \"c1\": 1e5, "
+                "\"delta\": 0"),
+       "materials.sheet.c3: missing"},
+      {"fibres without a direction",
+       replaced(good, "\"poisson_ratio\": 0.3, \"thickness\": 0.01",
+                "\"poisson_ratio\": 0.5, \"thickness\": 0.01, \"model\": \"lee_sacks\", \"c1\": 1e5, "
+                "\"c3\": 5, \"delta\": 0"),
+       "bodies[0] 'strip'.fibre_direction: missing"},
+      {"fibres along the normal",
+       replaced(replaced(good, "\"poisson_ratio\": 0.3, \"thickness\": 0.01",
+                         "\"poisson_ratio\": 0.5, \"thickness\": 0.01, \"model\": \"lee_sacks\", "
+                         "\"c1\": 1e5, \"c3\": 5, \"delta\": 0"),
+                "\"pressure_load\"", "\"fibre_direction\": [0, 0, 2], \"pressure_load\""),
+       "bodies[0] 'strip'.fibre_direction: along the sheet's normal at particle 0"},
+      {"a fibre direction for an isotropic sheet",
+       replaced(good, "\"pressure_load\"", "\"fibre_direction\": [1, 0, 0], \"pressure_load\""),
+       "bodies[0] 'strip'.fibre_direction: the body's material has no fibre term (lee_sacks with delta < 1)"},
+      {"a fibre direction for an elastic body",
+       replaced(good, "\"material\": \"rubber\", \"shape\"",
+                "\"material\": \"rubber\", \"fibre_direction\": [1, 0, 0], \"shape\""),
+       "bodies[1].fibre_direction: only shell bodies have a fibre direction"},
       {"lee_sacks compressible",
        replaced(good, "\"thickness\": 0.01",
                 "\"thickness\": 0.01, \"model\": \"lee_sacks\", \"c1\": 1e4, \"c2\": 20"),
@@ -796,6 +825,143 @@ TEST_CASE("shell lee_sacks: the stress of the closed forms, the energy's derivat
   shell_stress(ShellParams(z), E, Sls, pls);
   CHECK(Snh == Sls);
   CHECK(pnh == pls);
+}
+
+TEST_CASE(
+    "shell lee_sacks with fibres: the fibre term's closed forms, tension only, the energy's derivative and "
+    "the stiffening bound",
+    "[shell]") {
+  // psi = mu/2 x + c1/2 (delta (exp(c2 x^2) - 1) + (1 - delta) (exp(c3 y^2) - 1)), y = I4 - 1 > 0, mu = E /
+  // 3; the leaflet's fit (docs/model.md): E = 1 MPa, c1 = 100 kPa, c3 = 5, delta = 0, and a mixed delta =
+  // 0.5.
+  for (const double delta : {0.0, 0.5}) {
+    Material m = shell_sheet(1e6, 0.5, 1e-3, 1100.0);
+    m.neo_hookean = true;
+    m.lee_sacks_c1 = 1e5;
+    m.lee_sacks_c2 = 20.0;
+    m.lee_sacks_c3 = 5.0;
+    m.lee_sacks_delta = delta;
+    const ShellParams p(m);
+    const double mu = 1e6 / 3.0, c1 = 1e5, c2 = 20.0, c3 = 5.0;
+    auto W1 = [&](double x) { return 0.5 * mu + c1 * delta * c2 * x * std::exp(c2 * x * x); };
+    auto W4 = [&](double y) { return y > 0.0 ? c1 * (1.0 - delta) * c3 * y * std::exp(c3 * y * y) : 0.0; };
+    auto stress = [&](const Mat3& E, const Eigen::Vector2d& a, double* stiff = nullptr) {
+      Mat3 S;
+      double psi = 0.0;
+      shell_stress(p, E, S, psi, stiff, &a);
+      return std::pair{S, psi};
+    };
+    auto green = [](double l1, double l2) {
+      Mat3 E = Mat3::Zero();
+      E(0, 0) = 0.5 * (l1 * l1 - 1.0);
+      E(1, 1) = 0.5 * (l2 * l2 - 1.0);
+      return E;
+    };
+    const Eigen::Vector2d along(1.0, 0.0), across(0.0, 1.0);
+    // Uniaxial stretch l along the fibres (lambda2 = lambda3 = l^-1/2 keeps S22 = 0: the fibre term has no
+    // 22 part): sigma = 2 W1 (l^2 - 1 / l) + 2 l^2 W4(l^2 - 1).
+    auto sig_fibre = [&](double l) {
+      const double x = l * l + 2.0 / l - 3.0;
+      return 2 * W1(x) * (l * l - 1.0 / l) + 2 * l * l * W4(l * l - 1.0);
+    };
+    // The stiffening bound is over the neo-Hookean's unstrained tangent 3 mu (the wave speed the step starts
+    // from): it covers the tangent d sigma / d l along the fibres, within 4x. The fibres are stiff in tension
+    // from the start (4 c1 (1 - delta) c3 at l = 1+), so the bound is above 1 unstrained.
+    double prev = 0.0;
+    const double dl = 1e-6;
+    for (double l = 1.0; l <= 1.2 + 1e-12; l += 0.025) {
+      const double x = l * l + 2.0 / l - 3.0, y = l * l - 1.0;
+      double st = 1.0;
+      const auto [S, psi] = stress(green(l, 1.0 / std::sqrt(l)), along, &st);
+      INFO("delta " << delta << ", stretch " << l);
+      CHECK(l * l * S(0, 0) == Approx(sig_fibre(l)).margin(1e-6));
+      CHECK(std::abs(S(1, 1)) < 1e-6);
+      CHECK(psi == Approx(0.5 * mu * x + 0.5 * c1 * delta * (std::exp(c2 * x * x) - 1.0) +
+                          0.5 * c1 * (1.0 - delta) * (std::exp(c3 * y * y) - 1.0))
+                       .margin(1e-9));
+      // The same stretch across the fibres shortens them: the isotropic law alone (tension only).
+      Mat3 Si, So;
+      double pi = 0.0, po = 0.0;
+      shell_stress(p, green(l, 1.0 / std::sqrt(l)), Si, pi, nullptr, &across);
+      shell_stress(p, green(l, 1.0 / std::sqrt(l)), So, po);  // no fibre direction
+      CHECK(Si == So);
+      CHECK(pi == po);
+      const double t = (sig_fibre(l + dl) - sig_fibre(l > 1.0 ? l - dl : l)) / (l > 1.0 ? 2 * dl : dl);
+      if (l == 1.0) CHECK(t == Approx(3 * mu + 4 * c1 * (1.0 - delta) * c3).epsilon(1e-4));
+      INFO("stiffening " << st << ", tangent over 3 mu " << t / (3 * mu));
+      CHECK(st >= t / (3 * mu));
+      CHECK(st <= 4.0 * t / (3 * mu));
+      CHECK(st > prev);
+      prev = st;
+    }
+    // At the fit's 16 % the fibres carry the tangent of the cusps' circumferential 15 MPa (delta 0).
+    if (delta == 0.0) {
+      const double l = 1.16, t = (sig_fibre(l + dl) - sig_fibre(l - dl)) / (2 * dl);
+      CHECK(sig_fibre(l) == Approx(1.0e6).epsilon(0.03));
+      CHECK(t == Approx(15e6).epsilon(0.05));
+    }
+    // Fibres at 30 degrees, a general strain: the energy's derivative is the stress, and S is symmetric.
+    const Eigen::Vector2d a30(std::cos(std::numbers::pi / 6), std::sin(std::numbers::pi / 6));
+    Mat3 E = green(1.12, 0.97);
+    E(0, 1) = E(1, 0) = 0.04;
+    const auto [S, psi] = stress(E, a30);
+    CHECK(S(0, 1) == S(1, 0));
+    for (const auto& [i, j] : {std::pair{0, 0}, {1, 1}, {0, 1}}) {
+      Mat3 Ep = E, Em = E;
+      const double h = 1e-7, k = i == j ? 1.0 : 0.5;
+      Ep(i, j) += k * h, Ep(j, i) = Ep(i, j);
+      Em(i, j) -= k * h, Em(j, i) = Em(i, j);
+      CHECK((stress(Ep, a30).second - stress(Em, a30).second) / (2 * h) == Approx(S(i, j)).epsilon(1e-5));
+    }
+  }
+  // delta = 1 (the default) ignores a fibre direction: the isotropic law bit for bit.
+  Material m = shell_sheet(1e6, 0.5, 1e-3, 1100.0);
+  m.neo_hookean = true;
+  m.lee_sacks_c1 = 1e4;
+  m.lee_sacks_c2 = 20.0;
+  m.lee_sacks_c3 = 5.0;
+  Mat3 E = Mat3::Zero(), S1, S2;
+  E(0, 0) = 0.1, E(1, 1) = -0.02, E(0, 1) = E(1, 0) = 0.03;
+  double p1 = 0.0, p2 = 0.0, s1 = 1.0, s2 = 1.0;
+  const Eigen::Vector2d a(1.0, 0.0);
+  shell_stress(ShellParams(m), E, S1, p1, &s1, &a);
+  shell_stress(ShellParams(m), E, S2, p2, &s2);
+  CHECK(S1 == S2);
+  CHECK(p1 == p2);
+  CHECK(s1 == s2);
+}
+
+TEST_CASE(
+    "shell fibres: a body's fibre_direction and the aortic leaflets' circumferential fibres reach every "
+    "particle, projected on its tangent plane",
+    "[shell]") {
+  // A flat strip with a direction out of its plane: the fibre is the direction's in-plane part, normalised.
+  Scene s = plate_scene(0.5, 0.025, 0.05, 1e6, 0.5, 1000.0, 0.0, 0.0);
+  s.materials[0].neo_hookean = true;
+  s.materials[0].lee_sacks_c1 = 1e5;
+  s.materials[0].lee_sacks_c3 = 5.0;
+  s.materials[0].lee_sacks_delta = 0.0;
+  s.bodies[0].fibre_direction = Vec3(1.0, 1.0, 1.0).normalized();
+  const World w(s);
+  const Shells& sh = w.shells();
+  REQUIRE(sh.size() > 100);
+  for (std::size_t k = 0; k < sh.size(); ++k) {
+    INFO("particle " << k << " fibre " << sh.fibre(k).transpose());
+    CHECK(sh.fibre(k).isApprox(Vec3(1.0, 1.0, 0.0).normalized(), 1e-12));
+  }
+  // Without a direction, the shell leaflets' own: horizontal and perpendicular to the radius before the
+  // projection, so after it unit, in the tangent plane and along theta's in-plane part.
+  AorticRootParams rp;
+  rp.shell_leaflets = true;
+  rp.mirror_leaflets = true;
+  const ShapeSample leaf = sample_aortic_root(rp, AorticPart::Leaflet, 1, 0.001);
+  REQUIRE(leaf.fibres.size() == leaf.points.size());
+  for (std::size_t k = 0; k < leaf.points.size(); ++k) {
+    const Vec3 q = leaf.points[k] - rp.base, f = leaf.fibres[k];
+    CHECK(f.norm() == Approx(1.0).epsilon(1e-12));
+    CHECK(std::abs(f.y()) < 1e-12);
+    CHECK(std::abs(f.x() * q.x() + f.z() * q.z()) < 1e-12);
+  }
 }
 
 TEST_CASE("shell lee_sacks: a stiffened plate takes shorter steps and resumes bitwise",

@@ -704,6 +704,8 @@ ShapeSample AorticRoot::leaflet_shell_uncached(int k, double dx) const {
     out.points.push_back(p_.base + q);
     out.normals.push_back(sign * normals[m]);
     out.areas.push_back(areas[m]);
+    // Circumferential about the root's axis (+y): the cusps' collagen runs from commissure to commissure.
+    out.fibres.push_back(Vec3(-q.z(), 0.0, q.x()) / std::max(r, 1e-12));
     out.clamped.push_back(embedded ? 2 : row_of[m] == 0 || depth < kShellClampDepth * dx || post ? 1 : 0);
   }
   // A point left out hands its area to the nearest kept point, so the areas still tile the mid-surface.

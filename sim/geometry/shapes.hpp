@@ -23,6 +23,8 @@ struct ShapeSample {
   std::vector<Vec3> normals;
   std::vector<double> areas;
   std::vector<uint8_t> pinned;
+  // Empty, or per point a fibre direction for shells with fibres (the aortic leaflets: circumferential).
+  std::vector<Vec3> fibres;
 };
 
 // Whether a shape is a shell's mid-surface (one layer of particles).

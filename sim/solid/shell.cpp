@@ -88,6 +88,9 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
     perpendicular_frame(n, u, v);  // (u, v, n) orthonormal, right-handed
     T1_.push_back(u);
     T2_.push_back(v);
+    const Vec3 f = seed[i].fibre - seed[i].fibre.dot(n) * n;
+    const double fl = f.norm();
+    fibre_.push_back(fl > 1e-9 ? Eigen::Vector2d(u.dot(f) / fl, v.dot(f) / fl) : Eigen::Vector2d(0.0, 0.0));
     area_.push_back(seed[i].area);
     mass_.push_back(sp.rho0 * sp.t * seed[i].area);
     inertia_.push_back(sp.rho0 * sp.t * sp.t * sp.t / 12.0 * seed[i].area);
@@ -228,6 +231,13 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
   vm_.assign(n, 0.0);
   strain_.assign(n, 0.0);
   stiffening_.assign(n, 1.0);
+  // The unstrained stiffening: 1, except where fibres stiffen the sheet from the start (their W44 at I4 = 1).
+  for (std::size_t s = 0; s < n; ++s)
+    if (params_[material_[s]].c1 > 0.0) {
+      Mat3 S;
+      double psi = 0.0;
+      shell_stress(params_[material_[s]], Mat3::Zero(), S, psi, &stiffening_[s], &fibre_[s]);
+    }
   Nres_.assign(n, Mat2::Zero());
   Mres_.assign(n, Mat2::Zero());
   Qres_.assign(n, Eigen::Vector2d::Zero());
@@ -296,7 +306,7 @@ void Shells::update(const Particles& P) {
       El.topLeftCorner<2, 2>() -= Csym;
       Mat3 Sl;
       double psi = 0.0, st = 1.0;
-      shell_stress(sp, El, Sl, psi, sp.c1 > 0.0 ? &st : nullptr);
+      shell_stress(sp, El, Sl, psi, sp.c1 > 0.0 ? &st : nullptr, &fibre_[s]);
       stiff = std::max(stiff, st);
       const double V = vol_[kGauss * s + k];
       U += V * psi;

@@ -56,6 +56,8 @@ struct ShellSeed {
   Vec3 normal = Vec3::UnitZ();
   double area = 0.0;
   uint8_t support = 0;  // 0 free, 1 fixed (position and rotation), 2 pinned (position only)
+  Vec3 fibre =
+      Vec3::Zero();  // fibre direction (Lee-Sacks with fibres), projected on the tangent plane; 0: none
 };
 
 class Shells {
@@ -96,6 +98,8 @@ class Shells {
   uint8_t support(std::size_t s) const { return support_[s]; }
   const Vec3& reference(std::size_t s) const { return X_[s]; }
   const Vec3& reference_normal(std::size_t s) const { return N_[s]; }
+  // The fibre direction in the reference (unit, in the tangent plane; zero where the sheet has none).
+  Vec3 fibre(std::size_t s) const { return fibre_[s](0) * T1_[s] + fibre_[s](1) * T2_[s]; }
   const Vec3& director(std::size_t s) const { return d_[s]; }
   const Vec3& omega(std::size_t s) const { return omega_[s]; }
   double thickness(std::size_t s) const { return params_[material_[s]].t; }
@@ -189,6 +193,7 @@ class Shells {
   // Reference, per shell slot.
   std::vector<uint32_t> id_;
   std::vector<Vec3> X_, N_, T1_, T2_;
+  std::vector<Eigen::Vector2d> fibre_;  // unit fibre direction in (T1, T2); zero: none
   std::vector<double> area_, mass_, inertia_;
   std::vector<uint8_t> edge_;  // 1 for a particle near an edge of its sheet (over_sheet)
   std::vector<uint16_t> material_;

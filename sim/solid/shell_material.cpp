@@ -19,9 +19,12 @@ ShellParams::ShellParams(const Material& m)
       hourglass(m.hourglass),
       neo_hookean(m.neo_hookean),
       c1(m.lee_sacks_c1),
-      c2(m.lee_sacks_c2) {}
+      c2(m.lee_sacks_c2),
+      c3(m.lee_sacks_c3),
+      delta(m.lee_sacks_delta) {}
 
-void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi, double* stiffening) {
+void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi, double* stiffening,
+                  const Eigen::Vector2d* fibre) {
   S.setZero();
   const double ks = p.kappa * 2.0 * p.mu;  // transverse shear, S_a3 = kappa 2 mu E_a3
   S(0, 2) = S(2, 0) = ks * E(0, 2);
@@ -46,17 +49,32 @@ void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi, dou
     psi += 0.5 * p.mu * x;
     return;
   }
-  // Lee-Sacks (isotropic): W1 = mu/2 + c1 c2 x exp(c2 x^2), S = 2 W1 g.
+  // Lee-Sacks: W1 = mu/2 + c1 delta c2 x exp(c2 x^2), S = 2 W1 g (+ the fibre's 2 W4 a0 a0^T).
   const double e = std::exp(p.c2 * x * x);
-  const double W1 = 0.5 * p.mu + p.c1 * p.c2 * x * e;
+  const double W1 = 0.5 * p.mu + p.c1 * p.delta * p.c2 * x * e;
   S.topLeftCorner<2, 2>() = 2.0 * W1 * g;
-  psi += 0.5 * p.mu * x + 0.5 * p.c1 * (e - 1.0);
+  psi += 0.5 * p.mu * x + 0.5 * p.c1 * p.delta * (e - 1.0);
+  double W4 = 0.0, W44 = 0.0;
+  if (fibre && p.delta < 1.0) {
+    const double y = fibre->dot(C * *fibre) - 1.0;  // I4 - 1
+    // Tension only; at y = 0 the stress is zero but W44 is not: the fibres' stiffness in tension, which the
+    // step's bound must include from the unstrained state on.
+    if (y >= 0.0) {
+      const double c = p.c1 * (1.0 - p.delta), e4 = std::exp(p.c3 * y * y);
+      W4 = c * p.c3 * y * e4;
+      W44 = c * p.c3 * (1.0 + 2.0 * p.c3 * y * y) * e4;
+      S.topLeftCorner<2, 2>() += 2.0 * W4 * (*fibre) * fibre->transpose();
+      psi += 0.5 * c * (e4 - 1.0);
+    }
+  }
   if (stiffening) {
-    const double W11 = p.c1 * p.c2 * (1.0 + 2.0 * p.c2 * x * x) * e;
-    // The material part (W1, W11) times the geometric one: the largest squared stretch in the plane.
+    const double W11 = p.c1 * p.delta * p.c2 * (1.0 + 2.0 * p.c2 * x * x) * e;
+    // The material part (W1, W11; W4, W44 with |dI4/dC| = |a0|^2 = 1) times the geometric one: the largest
+    // squared stretch in the plane.
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(C, Eigen::EigenvaluesOnly);
     const double stretch2 = std::max(1.0, eig.eigenvalues().maxCoeff());
-    *stiffening = std::max(1.0, stretch2 * (2.0 * W1 + 2.0 * W11 * g.squaredNorm()) / p.mu);
+    *stiffening =
+        std::max(1.0, stretch2 * (2.0 * W1 + 2.0 * W11 * g.squaredNorm() + 2.0 * W4 + 2.0 * W44) / p.mu);
   }
 }
 

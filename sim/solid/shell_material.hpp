@@ -16,6 +16,13 @@
 //     in plane stress as the neo-Hookean above with c0 = mu = E / 3: psi = mu/2 x + c1/2 (exp(c2 x^2) - 1),
 //     x = I1 - 3 = tr C2 + 1 / det C2 - 3; S_ab = 2 W1 (delta_ab - C2^-1_ab / det C2), W1 = dpsi/dI1 = mu/2 +
 //     c1 c2 x exp(c2 x^2). Soft at small strain (E), it stiffens as collagen does: c1, c2 set where.
+//   - Lee-Sacks with fibres (delta < 1): the isotropic exponential scaled by delta, and the fibre term
+//     c1/2 (1 - delta) (exp(c3 y^2) - 1), y = I4 - 1, I4 = a0 . C2 a0 the squared stretch along the unit
+//     fibre direction a0 of the reference tangent plane; in tension only (y > 0: collagen does not carry
+//     compression; Holzapfel, Gasser & Ogden 2000 use the same switch). a0 lies in the plane, so the plane
+//     stress multiplier is the isotropic one's and S_ab += 2 W4 a0_a a0_b, W4 = c1 (1 - delta) c3 y
+//     exp(c3 y^2). Aortic leaflets: a0 circumferential (the collagen of the cusps runs from commissure to
+//     commissure; Sacks, Merryman & Schmidt 2009, J. Biomech. 42:1804, recalled).
 #pragma once
 
 #include <Eigen/Dense>
@@ -37,7 +44,8 @@ struct ShellParams {
   double damping = 0.0;  // [1/s]
   double hourglass = 0.0;
   bool neo_hookean = false;
-  double c1 = 0.0, c2 = 0.0;  // Lee-Sacks exponential term (0: none)
+  double c1 = 0.0, c2 = 0.0;     // Lee-Sacks exponential terms (c1 = 0: none)
+  double c3 = 0.0, delta = 1.0;  // the fibre term's exponent and the isotropic share (1: no fibre term)
   ShellParams() = default;
   explicit ShellParams(const Material& m);
 };
@@ -46,6 +54,9 @@ struct ShellParams {
 // stiffening (Lee-Sacks only), an upper estimate of the in-plane tangent stiffness over its small-strain
 // value: lambda_max^2 (2 W1 + 2 W11 |dI1/dC|^2) / mu with W11 = d2psi/dI1^2 and lambda_max^2 the largest
 // eigenvalue of C2 (1 at no strain; the wave speed grows with its square root, Shells::stable_dt).
-void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi, double* stiffening = nullptr);
+// fibre: the unit fibre direction in the local frame's plane (Lee-Sacks with delta < 1; nullptr or zero:
+// none).
+void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi, double* stiffening = nullptr,
+                  const Eigen::Vector2d* fibre = nullptr);
 
 }  // namespace aortasph
