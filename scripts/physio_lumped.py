@@ -13,7 +13,8 @@ the distance between the two discs; --area, default the outlet disc's). Explicit
 (default 4), the RCR as in docs/model.md (C dPc/dt = Q - (Pc - Pd)/Rd, P_out = Pc + Rp Q).
 
 Prints per cycle: stroke volume [ml], peak flow [ml/s], aortic (outlet) pressure max/min [mmHg], ejection time
-[s]. Not a validation of the SPH model (a lumped valve has no leaflets); a check that a scene's boundary
+[s], the valve's opening time in the cycle [s] and the time the shut valve holds the scene's cycle.hold_level
+(default 70 mmHg) or more [s] (issue 17's "held" target: 0.4 s). Not a validation of the SPH model (a lumped valve has no leaflets); a check that a scene's boundary
 conditions ask for physiological numbers at all (stop 42: the shipped physio scene's ask for 80 ml and 404 ml/s
 in its first cycle).
 """
@@ -110,9 +111,11 @@ def main():
     q = 0.0
     print("# %s: inertance %.3g Pa s^2/m^3 (length %.1f mm, area %.2f cm^2), EOA %.2f cm^2, RCR %.3g / %.3g / %.3g"
           % (a.scene, inertance, length * 1e3, area * 1e4, a.eoa, rp, c, rd))
-    print("cycle, stroke_volume_ml, peak_flow_ml_s, aortic_max_mmHg, aortic_min_mmHg, ejection_s")
+    hold = float(scene.get("cycle", {}).get("hold_level", 70.0 * MMHG))
+    print("cycle, stroke_volume_ml, peak_flow_ml_s, aortic_max_mmHg, aortic_min_mmHg, ejection_s, opening_s, held_s")
     for cycle in range(a.cycles):
-        sv = qmax = ejection = 0.0
+        sv = qmax = ejection = held = 0.0
+        opening = None
         pmax, pmin = -1e300, 1e300
         for n in range(steps):
             t = n * dt
@@ -128,9 +131,13 @@ def main():
             qmax = max(qmax, q)
             if q > 0.0:
                 ejection += dt
+                opening = t if opening is None else opening
+            elif p_out - p_lv >= hold:
+                held += dt
             pmax, pmin = max(pmax, p_out), min(pmin, p_out)
-        print("%d, %.1f, %.0f, %.1f, %.1f, %.3f" % (cycle + 1, sv * 1e6, qmax * 1e6, (pmax - background) / MMHG,
-                                                (pmin - background) / MMHG, ejection))
+        print("%d, %.1f, %.0f, %.1f, %.1f, %.3f, %.3f, %.3f" % (
+            cycle + 1, sv * 1e6, qmax * 1e6, (pmax - background) / MMHG, (pmin - background) / MMHG, ejection,
+            opening if opening is not None else float("nan"), held))
 
 
 if __name__ == "__main__":
