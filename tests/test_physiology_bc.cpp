@@ -983,9 +983,10 @@ TEST_CASE("scripts/physio_lumped.py: the shipped physio scene's boundary conditi
     std::istringstream cells(line);
     for (std::string cell; std::getline(cells, cell, ',');) last.push_back(std::stod(cell));
   }
-  REQUIRE(last.size() == 6);  // cycle, stroke volume, peak flow, aortic max, aortic min, ejection time
+  // cycle, stroke volume, peak flow, aortic max, aortic min, ejection time, opening time, held time
+  REQUIRE(last.size() == 8);
   INFO("cycle 3: " << last[1] << " ml, " << last[2] << " ml/s, aortic " << last[3] << " / " << last[4]
-                   << " mmHg, ejection " << last[5] << " s");
+                   << " mmHg, ejection " << last[5] << " s, opening " << last[6] << " s, held " << last[7] << " s");
   CHECK(last[0] == 3);
   CHECK(last[1] > 60.0);
   CHECK(last[1] < 90.0);
@@ -995,6 +996,12 @@ TEST_CASE("scripts/physio_lumped.py: the shipped physio scene's boundary conditi
   CHECK(last[3] < 130.0);
   CHECK(last[4] > 70.0);
   CHECK(last[4] < 90.0);
+  // The valve opens in the waveform's upstroke and holds 70 mmHg only while shut: within the 0.8 s period
+  // less the ejection, and for most of it (stop 58: opening 0.137 s, held 0.328 s of the 0.492 s shut).
+  CHECK(last[6] > 0.05);
+  CHECK(last[6] < 0.25);
+  CHECK(last[7] <= 0.8 - last[5] + 1e-9);
+  CHECK(last[7] > 0.5 * (0.8 - last[5]));
   // A scene without a pressure inlet and an RCR outlet is refused with exit 2.
   const std::string bad = "/usr/bin/python3 " + (root / "scripts" / "physio_lumped.py").string() + " " +
                           (root / "scenes" / "tube_flow.json").string() + " > /dev/null 2>&1";

@@ -56,8 +56,8 @@ struct ShellSeed {
   Vec3 normal = Vec3::UnitZ();
   double area = 0.0;
   uint8_t support = 0;  // 0 free, 1 fixed (position and rotation), 2 pinned (position only)
-  Vec3 fibre =
-      Vec3::Zero();  // fibre direction (Lee-Sacks with fibres), projected on the tangent plane; 0: none
+  // Fibre direction (Lee-Sacks with fibres), projected on the tangent plane by Shells; zero: none.
+  Vec3 fibre = Vec3::Zero();
 };
 
 class Shells {

@@ -55,14 +55,14 @@ void shell_stress(const ShellParams& p, const Mat3& E, Mat3& S, double& psi, dou
   S.topLeftCorner<2, 2>() = 2.0 * W1 * g;
   psi += 0.5 * p.mu * x + 0.5 * p.c1 * p.delta * (e - 1.0);
   double W4 = 0.0, W44 = 0.0;
-  if (fibre && p.delta < 1.0) {
-    const double y = fibre->dot(C * *fibre) - 1.0;  // I4 - 1
-    // Tension only; at y = 0 the stress is zero but W44 is not: the fibres' stiffness in tension, which the
-    // step's bound must include from the unstrained state on.
-    if (y >= 0.0) {
-      const double c = p.c1 * (1.0 - p.delta), e4 = std::exp(p.c3 * y * y);
+  if (fibre && p.delta < 1.0 && fibre->squaredNorm() > 0.0) {
+    // Tension only (y = I4 - 1 > 0). W44 is not zero at y = 0: the fibres are stiff from the first stretch,
+    // and the step's bound takes it at max(y, 0), from the unstrained state on (whatever the rounding of y).
+    const double y = fibre->dot(C * *fibre) - 1.0, yp = std::max(y, 0.0);
+    const double c = p.c1 * (1.0 - p.delta), e4 = std::exp(p.c3 * yp * yp);
+    W44 = c * p.c3 * (1.0 + 2.0 * p.c3 * yp * yp) * e4;
+    if (y > 0.0) {
       W4 = c * p.c3 * y * e4;
-      W44 = c * p.c3 * (1.0 + 2.0 * p.c3 * y * y) * e4;
       S.topLeftCorner<2, 2>() += 2.0 * W4 * (*fibre) * fibre->transpose();
       psi += 0.5 * c * (e4 - 1.0);
     }
