@@ -125,6 +125,38 @@ TEST_CASE("valve metrics: half-sine ejection, Gorlin and continuity EOA, opening
   CHECK(std::isnan(m.effective_height_mm));
 }
 
+TEST_CASE("valve metrics: the slow forward flow of bulging closed leaflets before opening is not ejection",
+          "[physiology]") {
+  // The synthetic cycle with a later, shorter ejection: a half-sine of 400 ml/s over 0.1-0.3 s, and before
+  // it, from 0.02 s, the closed leaflets' bulge read as a forward flow of 2-13 ml/s (1-3 % of the peak,
+  // wobbling as physio55n's cycle 2 did) while the LV is 50 mmHg below the aorta. The old definition (the
+  // last zero crossing before the peak) started ejection at 0.02 s: 280 ms, mean gradient -7.1 mmHg.
+  CycleSignals s = synthetic({400e-6}, {80.0});
+  const double qp = 400e-6;
+  for (std::size_t i = 0; i < s.t.size(); ++i) {
+    const double tau = s.t[i];
+    if (tau > 0.3) break;
+    double q = 0.0;
+    if (tau >= 0.1)
+      q = qp * std::sin(kPi * (tau - 0.1) / 0.2);
+    else if (tau > 0.02)
+      q = (7.5 + 5.5 * std::sin(2 * kPi * tau / 0.013)) * 1e-6;
+    s.valve_flow[i] = q;
+    s.lv_pressure[i] = s.aortic_pressure[i] + (tau >= 0.1 ? 10.0 : -50.0) * kPaPerMmHg;
+  }
+  CycleOptions o;
+  o.period = 0.8;
+  const auto cycles = all_cycle_metrics(s, o);
+  REQUIRE(cycles.size() == 1);
+  const CycleMetrics& m = cycles[0];
+  // The onset: the 5 % crossing (0.1 + 0.2 asin(0.05) / pi = 0.10318 s) taken back along the chord through
+  // the 10 % crossing (0.10638 s) to 0.09998 s.
+  CHECK(m.ejection_time_ms == Approx(200.0).epsilon(2e-3));
+  CHECK(m.mean_gradient_mmHg == Approx(10.0).epsilon(2e-3));
+  // The half-sine's volume 2 q_p T_e / pi = 50.93 ml; the bulge's 0.6 ml before it is not stroke volume.
+  CHECK(m.stroke_volume_ml == Approx(2 * qp * 0.2 / kPi * 1e6).epsilon(2e-3));
+}
+
 TEST_CASE("valve metrics: the diastolic hold counts the previous diastole's tail at the window's start",
           "[physiology]") {
   // The synthetic cycle with the closed valve holding 80 mmHg over its first 9 ms (the last diastole's
