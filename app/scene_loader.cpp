@@ -330,7 +330,7 @@ class Loader {
             "stj_height",     "aorta_radius",   "lvot_length",       "aorta_length",      "leaflet_free_edge",
             "leaflet_height", "leaflet_layers", "wall_layers",       "commissure_angles", "sinuses",
             "leaflet_shape",  "mirror_tilt",    "graft_diameter",    "graft_shape",       "neo_sinus_bulge",
-            "stj_diameter",   "cusps",          "commissure_post"};
+            "stj_diameter",   "cusps",          "commissure_post",   "lunula_height"};
   }
 
   // Reads the aortic_root parameters that o holds over p; with fill, every parameter, defaults written into
@@ -365,6 +365,7 @@ class Loader {
     if (o.has("mirror_tilt")) p.mirror_tilt = o.number("mirror_tilt");
     // Read only where given (no default written): the default follows the leaflets (shell or not).
     if (o.has("commissure_post")) p.commissure_post = o.non_negative("commissure_post");
+    if (o.has("lunula_height")) p.lunula_height = o.non_negative("lunula_height");
     surgical_params(o, p);
   }
 
@@ -540,6 +541,15 @@ class Loader {
                  ? "aortic_root.commissure_post"
                  : index("bodies", b) + ".shape.aortic_root.commissure_post",
              "commissure posts need shell leaflets (a leaflet material of type shell)");
+      }
+      // The lunula is a band of the shell's sheet.
+      for (std::size_t b = 0; b < s.bodies.size(); ++b) {
+        const Shape& sh = s.bodies[b].shape;
+        if (sh.kind != ShapeKind::AorticRoot || !(sh.aortic.lunula_height > 0.0)) continue;
+        fail(shared_root_keys_.count("lunula_height")
+                 ? "aortic_root.lunula_height"
+                 : index("bodies", b) + ".shape.aortic_root.lunula_height",
+             "a lunula needs shell leaflets (a leaflet material of type shell)");
       }
       return;
     }

@@ -138,6 +138,10 @@ struct AorticRootParams {
     return shell_leaflets && mirror_leaflets ? commissure_post_default : 0.0;
   }
   static constexpr double commissure_post_default = 0.005;
+  // The lunula (shell leaflets; sim/geometry/aortic_root.hpp): each leaflet's free margin stands this high
+  // [m] above its closure line at the centre, as a band on the leaflet's side of its coaptation planes,
+  // tapering to nothing at the commissures. 0: none (the free edge is the closure line).
+  double lunula_height = 0.0;
   // Surgical geometry (issue 19 item 1; docs/scenes.md, sim/geometry/aortic_root.hpp surgical_root). Graft
   // mode: graft_diameter > 0 makes the root a graft of that inner diameter (commissure and sinotubular-
   // junction radius = graft_diameter / 2; the annulus keeps annulus_radius), straight or with neo-sinuses

@@ -282,6 +282,91 @@ TEST_CASE("shell leaflets: commissure posts clamp the leaflets there and leave n
   CHECK(AorticRoot(p).post_points(dx).empty());
 }
 
+TEST_CASE("shell leaflets: the lunula stands on the free edges, in the planes beside the coaptation planes",
+          "[shell_leaflet][heavy]") {
+  const double dx = 0.001, h = 0.004;
+  AorticRootParams p = mirror();
+  AorticRootParams q = p;
+  q.lunula_height = h;
+  const AorticRoot plain(p), root(q);
+  const double rc = p.commissure_radius;
+  std::vector<ShapeSample> l(3);
+  for (int k = 0; k < 3; ++k) {
+    INFO("leaflet " << k);
+    const ShapeSample s0 = plain.leaflet_shell(k, dx);
+    l[k] = root.leaflet_shell(k, dx);
+    const ShapeSample& s = l[k];
+    // The sheet is as it was, the lunula appended.
+    REQUIRE(s.points.size() > s0.points.size() + 30);
+    REQUIRE(s.normals.size() == s.points.size());
+    REQUIRE(s.areas.size() == s.points.size());
+    REQUIRE(s.fibres.size() == s.points.size());
+    REQUIRE(s.clamped.size() == s.points.size());
+    const std::size_t n0 = s0.points.size();
+    CHECK(std::equal(s0.points.begin(), s0.points.end(), s.points.begin()));
+    CHECK(std::equal(s0.areas.begin(), s0.areas.end(), s.areas.begin()));
+    const double th0 = root.sector_start(k), th1 = th0 + root.sector_width(k);
+    const Vec3 n_a(-std::sin(th0), 0.0, -std::cos(th0)), n_b(std::sin(th1), 0.0, std::cos(th1));
+    double top = -1e300, band_area = 0.0;
+    for (std::size_t i = n0; i < s.points.size(); ++i) {
+      const Vec3 x = s.points[i] - p.base;
+      const double r = std::hypot(x.x(), x.z());
+      // dx/2 inside the sector from one of its coaptation planes, or both (the apex's column); the normal
+      // horizontal, across the band and into the sector (the aortic side, as the sheet's).
+      const bool on_a = std::abs(x.dot(n_a) - 0.5 * dx) < 1e-9, on_b = std::abs(x.dot(n_b) - 0.5 * dx) < 1e-9;
+      CHECK((on_a || on_b));
+      CHECK(s.normals[i].norm() == Approx(1.0).epsilon(1e-12));
+      CHECK(std::abs(s.normals[i].y()) < 1e-12);
+      if (on_a && !on_b) CHECK(s.normals[i].dot(n_a) == Approx(1.0).epsilon(1e-12));
+      if (on_b && !on_a) CHECK(s.normals[i].dot(n_b) == Approx(1.0).epsilon(1e-12));
+      // A whole number of spacings above a free-edge particle of the sheet, within the taper h (1 -
+      // (r/rc)^2).
+      bool above_edge = false;
+      for (std::size_t j = 0; j < n0 && !above_edge; ++j) {
+        const Vec3 e = s.points[j] - p.base;
+        const double up = (x.y() - e.y()) / dx;
+        above_edge = std::hypot(e.x() - x.x(), e.z() - x.z()) < 1e-12 && up > 0.5 &&
+                     std::abs(up - std::round(up)) < 1e-9 &&
+                     x.y() - e.y() <= h * (1 - r * r / (rc * rc)) + 1e-12;
+      }
+      CHECK(above_edge);
+      CHECK(s.areas[i] > 0.5 * dx * dx);
+      CHECK(s.areas[i] < 1.5 * dx * dx);
+      band_area += s.areas[i];
+      top = std::max(top, x.y());
+    }
+    // At the centre the lunula reaches h above the apex (the column's last particle within dx of it).
+    const Vec3 apex = root.leaflet_surface(k, 0.0, 0.5, 0.5 * dx);
+    CHECK(top >= apex.y() + h - dx - 1e-12);
+    CHECK(top <= apex.y() + h + 1e-9);
+    // Two bands of h (1 - (r/rc)^2) over about rc of horizontal edge each, 2/3 h rc apiece, less the columns'
+    // rounding down to whole spacings (about dx/2 each).
+    const double continuous = 2 * (2.0 / 3.0) * h * rc;
+    CHECK(band_area > 0.6 * continuous);
+    CHECK(band_area < continuous);
+    // Still one layer.
+    double closest = 1e300;
+    for (std::size_t i = n0; i < s.points.size(); ++i)
+      for (std::size_t j = 0; j < s.points.size(); ++j)
+        if (j != i) closest = std::min(closest, (s.points[j] - s.points[i]).norm());
+    CHECK(closest > 0.5 * dx);
+  }
+  // Neighbouring lunulae face each other across their coaptation plane, dx apart, and no blood is between
+  // them or within half a spacing of one.
+  double across = 1e300, blood_gap = 1e300;
+  for (int k = 0; k < 3; ++k)
+    for (const Vec3& x : l[k].points)
+      for (int m = 0; m < 3; ++m)
+        if (m != k)
+          for (const Vec3& y : l[m].points) across = std::min(across, (y - x).norm());
+  CHECK(across >= 0.99 * dx);
+  const std::vector<Vec3> blood = root.blood_points(dx);
+  for (int k = 0; k < 3; ++k)  // the lunulae (the sheets' gap is checked above)
+    for (std::size_t i = plain.leaflet_shell(k, dx).points.size(); i < l[k].points.size(); ++i)
+      for (const Vec3& b : blood) blood_gap = std::min(blood_gap, (b - l[k].points[i]).norm());
+  CHECK(blood_gap >= 0.5 * dx);
+}
+
 namespace {
 
 std::string replaced(std::string s, const std::string& from, const std::string& to) {
@@ -381,6 +466,16 @@ TEST_CASE("shell leaflets: the scene loader builds shell bodies, bad input exits
        "aortic_root.commissure_post: 0.007 is too long"},
       {"commissure post with volumetric leaflets", volumetric_valve("\"commissure_post\": 0.004, "),
        "aortic_root.commissure_post: commissure posts need shell leaflets"},
+      {"negative lunula",
+       replaced(valve_scene(0.001), "\"leaflet_shape\": \"mirror\"",
+                "\"leaflet_shape\": \"mirror\", \"lunula_height\": -0.002"),
+       "aortic_root.lunula_height"},
+      {"lunula higher than half the commissure height",
+       replaced(valve_scene(0.001), "\"leaflet_shape\": \"mirror\"",
+                "\"leaflet_shape\": \"mirror\", \"lunula_height\": 0.009"),
+       "aortic_root.lunula_height: 0.009 is too high"},
+      {"lunula on volumetric leaflets", volumetric_valve("\"lunula_height\": 0.003, "),
+       "aortic_root.lunula_height: a lunula needs shell leaflets"},
   };
   for (const Row& r : rows) {
     std::ofstream(dir / "scene.json") << r.scene;

@@ -718,7 +718,85 @@ ShapeSample AorticRoot::leaflet_shell_uncached(int k, double dx) const {
     }
     if (!kept.empty()) out.areas[best] += areas[m];
   }
+  if (p_.lunula_height > 0.0) add_lunula(k, dx, row_of, kept, out);
   return out;
+}
+
+void AorticRoot::add_lunula(int k, double dx, const std::vector<int>& row_of,
+                            const std::vector<std::size_t>& kept, ShapeSample& out) const {
+  // The free-edge particles: the first (s = 0, on commissure k's plane) and the last (s = 1, on the next
+  // commissure's plane) kept point of each row; a row of one point is the apex, on both planes. Each edge
+  // runs in its plane's parallel dx/2 inside the sector (leaflet_surface), so a column straight up from an
+  // edge particle stays in that plane.
+  std::vector<std::size_t> first, last;  // indices into out, by row from the attachment to the apex
+  std::size_t apex = out.points.size();
+  for (std::size_t j = 0; j < kept.size(); ++j) {
+    const int row = row_of[kept[j]];
+    if (row < 0) continue;
+    const bool starts = j == 0 || row_of[kept[j - 1]] != row;
+    const bool ends = j + 1 == kept.size() || row_of[kept[j + 1]] != row;
+    if (starts && ends) {
+      apex = j;
+    } else {
+      if (starts) first.push_back(j);
+      if (ends) last.push_back(j);
+    }
+  }
+  const double post_len = p_.mirror_leaflets ? p_.commissure_post_length() : 0.0;
+  const double th0 = phi_[k], th1 = phi_[k] + dphi_[k];
+  // Into the sector from each plane: the band's normal on the aortic side, as the sheet's normal turns there
+  // (the sheet's normal points up the root, and at the free edge away from the plane).
+  const Vec3 n0(-std::sin(th0), 0.0, -std::cos(th0)), n1(std::sin(th1), 0.0, std::cos(th1));
+  auto horizontal = [&](std::size_t a, std::size_t b) {
+    const Vec3 d = out.points[a] - out.points[b];
+    return std::hypot(d.x(), d.z());
+  };
+  auto column = [&](std::size_t j, const Vec3& normal, const Vec3& fibre, double width) {
+    const Vec3 q = out.points[j] - p_.base;
+    const double f = std::min(1.0, std::hypot(q.x(), q.z()) / p_.commissure_radius);
+    const double w = p_.lunula_height * (1.0 - f * f);
+    for (int i = 1; i * dx <= w * (1.0 + 1e-9); ++i) {
+      const Vec3 x = q + Vec3(0.0, i * dx, 0.0);
+      const double r = std::hypot(x.x(), x.z()), th = std::atan2(-x.z(), x.x());
+      if ((lumen_radius(x.y(), th) - r) / normal_scale(x.y(), th) < kShellWallMargin * dx) break;
+      bool post = false;
+      for (int c = 0; c < 3 && post_len > 0.0; ++c)
+        post = post || (x - commissure_point(c)).norm() < post_len;
+      out.points.push_back(p_.base + x);
+      out.normals.push_back(normal);
+      out.areas.push_back(width * dx);
+      out.fibres.push_back(fibre);
+      out.clamped.push_back(post ? 1 : 0);
+    }
+  };
+  for (int side = 0; side < 2; ++side) {
+    std::vector<std::size_t> edge = side == 0 ? first : last;
+    if (apex < out.points.size()) edge.push_back(apex);
+    const Vec3& n = side == 0 ? n0 : n1;
+    // A row whose end point was left out (at the wall, beside a neighbour's sector) ends inside the sheet.
+    std::erase_if(edge, [&](std::size_t j) {
+      return j != apex && std::abs((out.points[j] - p_.base).dot(n) - 0.5 * dx) > 0.25 * dx;
+    });
+    for (std::size_t e = 0; e < edge.size(); ++e) {
+      if (edge[e] == apex) continue;  // the apex's column below, once
+      // The horizontal width a column stands for: half the way to each neighbour along the edge.
+      const double width = 0.5 *
+                           ((e > 0 ? horizontal(edge[e], edge[e - 1]) : 0.0) +
+                            (e + 1 < edge.size() ? horizontal(edge[e], edge[e + 1]) : 0.0)) *
+                           (e > 0 && e + 1 < edge.size() ? 1.0 : 2.0);
+      const Vec3 q = out.points[edge[e]] - p_.base;
+      const Vec3 radial = Vec3(q.x(), 0.0, q.z()).normalized();  // along the edge, horizontally
+      column(edge[e], n, radial, width);
+    }
+  }
+  if (apex < out.points.size()) {
+    // The apex's column, on both planes: half the way to the nearest edge particle of each.
+    double width = 0.0;
+    for (const auto* edge : {&first, &last})
+      if (!edge->empty()) width += 0.5 * horizontal(apex, edge->back());
+    const Vec3 bisector = (n0 + n1).normalized();  // outward along the sector's bisector
+    column(apex, bisector, Vec3(0.0, 1.0, 0.0).cross(bisector).normalized(), width);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -922,6 +1000,10 @@ std::optional<AorticRootError> check_resolved(const AorticRootParams& p, double 
                    " is too long (less than commissure_radius / 2 = " + num(0.5 * p.commissure_radius) + ")");
   if (std::abs(p.mirror_tilt) > 30.0)
     return err("mirror_tilt", num(p.mirror_tilt) + " is outside [-30, 30] degrees");
+  if (p.lunula_height < 0.0) return err("lunula_height", "must not be negative");
+  if (p.lunula_height > 0.0 && !(p.lunula_height < 0.5 * p.commissure_height))
+    return err("lunula_height", num(p.lunula_height) + " is too high (less than commissure_height / 2 = " +
+                                    num(0.5 * p.commissure_height) + ")");
   // Labrosse leaflets follow free_edge and leaflet_height; mirror leaflets follow the root alone.
   if (!p.mirror_leaflets) {
     if (p.leaflet_free_edge < 2.0 * p.commissure_radius)

@@ -62,6 +62,11 @@
 //    commissure_height) the leaflet particles are clamped and the space between the two sheets (on the
 //    coaptation plane between their free edges, and below both sheets) is wall particles (post_points);
 //    the blood leaves that space.
+//  * Lunula (shell leaflets, lunula_height h > 0): each leaflet's free margin stands above the closure line,
+//    as in a real valve, whose cusps overlap there by the coaptation height. Columns of particles dx apart
+//    rise straight up from the sheet's free-edge particles, in the plane dx/2 inside the sector beside each
+//    coaptation plane (where the free edge runs), h (1 - (r / commissure_radius)^2) high at radius r, with
+//    the normal across the band into the sector (the aortic side); the sheet itself is unchanged.
 //  * Wall: rings of particles at y levels (spaced dx, closer where the sinus wall is steep, so spacing along
 //    the wall stays <= dx), each ring wall_layers deep, layer j at R + (j + 1/2) dx (scaled by the wall's
 //    slope so the layers are dx apart along the normal); rings and layers staggered by half a spacing; ends
@@ -189,6 +194,11 @@ class AorticRoot {
  private:
   double midline_length(double sag) const;
   ShapeSample leaflet_shell_uncached(int k, double dx) const;
+  // Appends leaflet k's lunula (lunula_height > 0) to its sheet `out`: columns dx apart straight up from the
+  // free-edge particles (row_of: leaflet_mid_surface's rows; kept: the mid-surface points that out holds, in
+  // order).
+  void add_lunula(int k, double dx, const std::vector<int>& row_of, const std::vector<std::size_t>& kept,
+                  ShapeSample& out) const;
   // The blood lattice (see blood_points), less the commissure posts' region and 0.75 dx round their
   // particles.
   std::vector<Vec3> blood_lattice(double dx) const;
