@@ -533,24 +533,24 @@ class Loader {
         volumetric = b;
     }
     if (shells == 0) {
-      // Commissure posts clamp shell leaflets to the wall: with volumetric leaflets there is none.
-      for (std::size_t b = 0; b < s.bodies.size(); ++b) {
-        const Shape& sh = s.bodies[b].shape;
-        if (sh.kind != ShapeKind::AorticRoot || !(sh.aortic.commissure_post > 0.0)) continue;
-        fail(shared_root_keys_.count("commissure_post")
-                 ? "aortic_root.commissure_post"
-                 : index("bodies", b) + ".shape.aortic_root.commissure_post",
-             "commissure posts need shell leaflets (a leaflet material of type shell)");
-      }
-      // The lunula is a band of the shell's sheet.
-      for (std::size_t b = 0; b < s.bodies.size(); ++b) {
-        const Shape& sh = s.bodies[b].shape;
-        if (sh.kind != ShapeKind::AorticRoot || !(sh.aortic.lunula_height > 0.0)) continue;
-        fail(shared_root_keys_.count("lunula_height")
-                 ? "aortic_root.lunula_height"
-                 : index("bodies", b) + ".shape.aortic_root.lunula_height",
-             "a lunula needs shell leaflets (a leaflet material of type shell)");
-      }
+      // Commissure posts clamp shell leaflets to the wall and a lunula is a band of the shell's sheet: with
+      // volumetric leaflets neither is.
+      struct ShellOnly {
+        const char* key;
+        double AorticRootParams::*value;
+        const char* message;
+      };
+      for (const ShellOnly& k :
+           {ShellOnly{"commissure_post", &AorticRootParams::commissure_post,
+                      "commissure posts need shell leaflets"},
+            ShellOnly{"lunula_height", &AorticRootParams::lunula_height, "a lunula needs shell leaflets"}})
+        for (std::size_t b = 0; b < s.bodies.size(); ++b) {
+          const Shape& sh = s.bodies[b].shape;
+          if (sh.kind != ShapeKind::AorticRoot || !(sh.aortic.*k.value > 0.0)) continue;
+          const std::string key = std::string("aortic_root.") + k.key;
+          fail(shared_root_keys_.count(k.key) ? key : index("bodies", b) + ".shape." + key,
+               std::string(k.message) + " (a leaflet material of type shell)");
+        }
       return;
     }
     if (shells != leaflets)

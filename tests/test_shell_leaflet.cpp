@@ -443,6 +443,11 @@ TEST_CASE("shell leaflets: the scene loader builds shell bodies, bad input exits
   struct Row {
     std::string what, scene, expect;
   };
+  // The shell valve with more aortic_root keys.
+  auto mirror_valve = [](const std::string& extra) {
+    return replaced(valve_scene(0.001), "\"leaflet_shape\": \"mirror\"",
+                    "\"leaflet_shape\": \"mirror\", " + extra);
+  };
   const std::vector<Row> rows = {
       {"one leaflet volumetric, the others shells", valve_scene(0.001, "", "tissue"),
        "bodies[1].material: the aortic leaflets are shells or none is"},
@@ -460,19 +465,12 @@ TEST_CASE("shell leaflets: the scene loader builds shell bodies, bad input exits
        replaced(valve_scene(0.001), "\"leaflet_shape\": \"mirror\"",
                 "\"leaflet_shape\": \"labrosse\", \"commissure_post\": 0.004"),
        "aortic_root.commissure_post: needs mirror leaflets"},
-      {"commissure post longer than half the commissure radius",
-       replaced(valve_scene(0.001), "\"leaflet_shape\": \"mirror\"",
-                "\"leaflet_shape\": \"mirror\", \"commissure_post\": 0.007"),
+      {"commissure post longer than half the commissure radius", mirror_valve("\"commissure_post\": 0.007"),
        "aortic_root.commissure_post: 0.007 is too long"},
       {"commissure post with volumetric leaflets", volumetric_valve("\"commissure_post\": 0.004, "),
        "aortic_root.commissure_post: commissure posts need shell leaflets"},
-      {"negative lunula",
-       replaced(valve_scene(0.001), "\"leaflet_shape\": \"mirror\"",
-                "\"leaflet_shape\": \"mirror\", \"lunula_height\": -0.002"),
-       "aortic_root.lunula_height"},
-      {"lunula higher than half the commissure height",
-       replaced(valve_scene(0.001), "\"leaflet_shape\": \"mirror\"",
-                "\"leaflet_shape\": \"mirror\", \"lunula_height\": 0.009"),
+      {"negative lunula", mirror_valve("\"lunula_height\": -0.002"), "aortic_root.lunula_height"},
+      {"lunula higher than half the commissure height", mirror_valve("\"lunula_height\": 0.009"),
        "aortic_root.lunula_height: 0.009 is too high"},
       {"lunula on volumetric leaflets", volumetric_valve("\"lunula_height\": 0.003, "),
        "aortic_root.lunula_height: a lunula needs shell leaflets"},
