@@ -330,7 +330,7 @@ class Loader {
             "stj_height",     "aorta_radius",   "lvot_length",       "aorta_length",      "leaflet_free_edge",
             "leaflet_height", "leaflet_layers", "wall_layers",       "commissure_angles", "sinuses",
             "leaflet_shape",  "mirror_tilt",    "graft_diameter",    "graft_shape",       "neo_sinus_bulge",
-            "stj_diameter",   "cusps",          "commissure_post",   "lunula_height"};
+            "stj_diameter",   "cusps",          "commissure_post",   "lunula_height",     "lunula_material"};
   }
 
   // Reads the aortic_root parameters that o holds over p; with fill, every parameter, defaults written into
@@ -366,6 +366,7 @@ class Loader {
     // Read only where given (no default written): the default follows the leaflets (shell or not).
     if (o.has("commissure_post")) p.commissure_post = o.non_negative("commissure_post");
     if (o.has("lunula_height")) p.lunula_height = o.non_negative("lunula_height");
+    if (o.has("lunula_material")) p.lunula_material = o.string("lunula_material");
     surgical_params(o, p);
   }
 
@@ -552,6 +553,18 @@ class Loader {
                std::string(k.message) + " (a leaflet material of type shell)");
         }
       return;
+    }
+    // The lunula's material: a shell material, for a lunula.
+    for (std::size_t b = 0; b < s.bodies.size(); ++b) {
+      const AorticRootParams& a = s.bodies[b].shape.aortic;
+      if (s.bodies[b].shape.kind != ShapeKind::AorticRoot || a.lunula_material.empty()) continue;
+      const std::string key = shared_root_keys_.count("lunula_material")
+                                  ? "aortic_root.lunula_material"
+                                  : index("bodies", b) + ".shape.aortic_root.lunula_material";
+      const int m = material_index(s, a.lunula_material, key);
+      if (s.materials[m].type != MaterialType::Shell)
+        fail(key, "'" + a.lunula_material + "' is not a shell material");
+      if (!(a.lunula_height > 0.0)) fail(key, "there is no lunula (aortic_root.lunula_height is 0)");
     }
     if (shells != leaflets)
       fail(index("bodies", volumetric) + ".material",

@@ -142,6 +142,10 @@ struct AorticRootParams {
   // [m] above its closure line at the centre, as a band on the leaflet's side of its coaptation planes,
   // tapering to nothing at the commissures. 0: none (the free edge is the closure line).
   double lunula_height = 0.0;
+  // The lunula's material (a shell material's name; empty: the leaflet's): a real lunula is thinner than the
+  // belly, and a lunula as stiff as the leaflet stands on its free edge like a rib (docs/scenes.md,
+  // "Lunula").
+  std::string lunula_material;
   // Surgical geometry (issue 19 item 1; docs/scenes.md, sim/geometry/aortic_root.hpp surgical_root). Graft
   // mode: graft_diameter > 0 makes the root a graft of that inner diameter (commissure and sinotubular-
   // junction radius = graft_diameter / 2; the annulus keeps annulus_radius), straight or with neo-sinuses

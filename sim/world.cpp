@@ -135,6 +135,12 @@ World::World(const Scene& scene)
     // Boundary particles (walls, bodies) enter the fluid's sums with the fluid's mass per particle, rho0 dx^3
     // (Adami et al. 2012 use volumes); a body's own mass lives in its RigidBody.
     const double rho0 = mat.type == MaterialType::Fluid ? mat.density : wall_ref_.rho0;
+    // An aortic shell leaflet's lunula may have its own material (the scene loader checked it is a shell).
+    uint16_t lunula_material = static_cast<uint16_t>(body.material);
+    if (!sample.lunula.empty() && !body.shape.aortic.lunula_material.empty())
+      for (std::size_t m = 0; m < scene_.materials.size(); ++m)
+        if (scene_.materials[m].name == body.shape.aortic.lunula_material)
+          lunula_material = static_cast<uint16_t>(m);
     const std::size_t first = P_.size();
     P_.resize(first + sample.points.size());
     for (std::size_t k = 0; k < sample.points.size(); ++k) {
@@ -143,7 +149,8 @@ World::World(const Scene& scene)
       P_.x0[i] = sample.points[k];
       P_.kind[i] = kind_of(mat.type);
       P_.body[i] = static_cast<uint16_t>(b);
-      P_.material[i] = static_cast<uint16_t>(body.material);
+      P_.material[i] =
+          !sample.lunula.empty() && sample.lunula[k] ? lunula_material : static_cast<uint16_t>(body.material);
       P_.id[i] = static_cast<uint32_t>(i);
       P_.m[i] = rho0 * volume;
       P_.rho[i] = rho0;

@@ -421,6 +421,38 @@ std::string volumetric_valve(const std::string& extra) {
 
 }  // namespace
 
+TEST_CASE("shell leaflets: the lunula's own material (thinner) goes to the lunula's particles alone",
+          "[shell_leaflet]") {
+  // The valve with a 4 mm lunula of a 0.2 mm sheet beside 0.45 mm leaflets.
+  std::string text =
+      replaced(valve_scene(0.001), "\"leaflet_shape\": \"mirror\"",
+               "\"leaflet_shape\": \"mirror\", \"lunula_height\": 0.004, \"lunula_material\": \"lun\"");
+  text = replaced(
+      text, "\"tissue\": {",
+      "\"lun\": { \"type\": \"shell\", \"density\": 1100, \"youngs_modulus\": 1.0e6, "
+      "\"poisson_ratio\": 0.5, \"thickness\": 0.0002, \"model\": \"neo_hookean\" },\n    \"tissue\": {");
+  const LoadedScene ls = load_scene_text(text, {}, "valve", ".");
+  World w(ls.scene);
+  const Particles& P = w.particles();
+  const AorticRoot root(ls.scene.bodies[0].shape.aortic);
+  std::size_t band = 0, thin = 0;
+  for (int k = 0; k < 3; ++k) {
+    const ShapeSample s = root.leaflet_shell(k, 0.001);
+    REQUIRE(s.lunula.size() == s.points.size());
+    for (const uint8_t l : s.lunula) band += l;
+  }
+  REQUIRE(band > 100);
+  for (std::size_t s = 0; s < w.shells().size(); ++s) {
+    const std::size_t i = w.shells().at(s);
+    const bool lun = ls.scene.materials[P.material[i]].name == "lun";
+    thin += lun;
+    // The sheet keeps the leaflet's material; the body is the leaflet's either way.
+    CHECK(w.shells().thickness(s) == (lun ? 0.0002 : 0.00045));
+    CHECK(ls.scene.materials[ls.scene.bodies[P.body[i]].material].name == "leaf");
+  }
+  CHECK(thin == band);
+}
+
 TEST_CASE("shell leaflets: the scene loader builds shell bodies, bad input exits 2 naming the key",
           "[shell_leaflet][bad-input]") {
   const LoadedScene ls = load_scene_text(valve_scene(0.001), {}, "valve", ".");
@@ -474,6 +506,13 @@ TEST_CASE("shell leaflets: the scene loader builds shell bodies, bad input exits
        "aortic_root.lunula_height: 0.009 is too high"},
       {"lunula on volumetric leaflets", volumetric_valve("\"lunula_height\": 0.003, "),
        "aortic_root.lunula_height: a lunula needs shell leaflets"},
+      {"lunula material unknown", mirror_valve("\"lunula_height\": 0.003, \"lunula_material\": \"nope\""),
+       "aortic_root.lunula_material: unknown material 'nope'"},
+      {"lunula material not a shell",
+       mirror_valve("\"lunula_height\": 0.003, \"lunula_material\": \"tissue\""),
+       "aortic_root.lunula_material: 'tissue' is not a shell material"},
+      {"lunula material without a lunula", mirror_valve("\"lunula_material\": \"leaf\""),
+       "aortic_root.lunula_material: there is no lunula"},
   };
   for (const Row& r : rows) {
     std::ofstream(dir / "scene.json") << r.scene;

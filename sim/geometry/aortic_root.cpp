@@ -743,6 +743,7 @@ void AorticRoot::add_lunula(int k, double dx, const std::vector<int>& row_of,
     }
   }
   const double post_len = p_.mirror_leaflets ? p_.commissure_post_length() : 0.0;
+  out.lunula.assign(out.points.size(), 0);
   const double th0 = phi_[k], th1 = phi_[k] + dphi_[k];
   // Into the sector from each plane: the band's normal on the aortic side, as the sheet's normal turns there
   // (the sheet's normal points up the root, and at the free edge away from the plane).
@@ -767,6 +768,7 @@ void AorticRoot::add_lunula(int k, double dx, const std::vector<int>& row_of,
       out.areas.push_back(width * dx);
       out.fibres.push_back(fibre);
       out.clamped.push_back(post ? 1 : 0);
+      out.lunula.push_back(1);
     }
   };
   for (int side = 0; side < 2; ++side) {

@@ -25,6 +25,9 @@ struct ShapeSample {
   std::vector<uint8_t> pinned;
   // Empty, or per point a fibre direction for shells with fibres (the aortic leaflets: circumferential).
   std::vector<Vec3> fibres;
+  // Empty, or per point 1 where the point is an aortic shell leaflet's lunula
+  // (AorticRootParams::lunula_height), which may have its own material.
+  std::vector<uint8_t> lunula;
 };
 
 // Whether a shape is a shell's mid-surface (one layer of particles).
