@@ -166,7 +166,7 @@ def sides(x, body, ids, blood, leaf, dx):
 def report_crossings(seen, frames, scene, dx):
     """Prints the blood that changed sides between the frames (see --crossings)."""
     span = frames[-1][0] - frames[0][0]
-    for frm, to, name in ((1, -1, "aortic -> ventricular"), (-1, 1, "ventricular -> aortic")):
+    for frm, name in ((1, "aortic -> ventricular"), (-1, "ventricular -> aortic")):
         went = []
         for h in seen.values():
             last = None

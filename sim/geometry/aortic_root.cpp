@@ -688,8 +688,7 @@ ShapeSample AorticRoot::leaflet_shell_uncached(int k, double dx) const {
     const double depth = (lumen_radius(q.y(), th) - r) / normal_scale(q.y(), th);
     // Commissure posts: the leaflets are attached to each other and to the wall within the post's distance
     // of a commissure (the tissue is continuous there in a real root).
-    bool post = false;
-    for (int c = 0; c < 3 && post_len > 0.0; ++c) post = post || (q - commissure_point(c)).norm() < post_len;
+    const bool post = near_commissure(q, post_len);
     // The embedded row (row -1) is the leaflet's tissue inside the wall: it closes the gap between the
     // first row and the wall's first layer, through which blood sliding along the wall passed round the
     // attachment (docs/scenes.md, "Embedded row"). None within a post (the post's wall particles are there).
@@ -760,9 +759,7 @@ void AorticRoot::add_lunula(int k, double dx, const std::vector<int>& row_of,
       const Vec3 x = q + Vec3(0.0, i * dx, 0.0);
       const double r = std::hypot(x.x(), x.z()), th = std::atan2(-x.z(), x.x());
       if ((lumen_radius(x.y(), th) - r) / normal_scale(x.y(), th) < kShellWallMargin * dx) break;
-      bool post = false;
-      for (int c = 0; c < 3 && post_len > 0.0; ++c)
-        post = post || (x - commissure_point(c)).norm() < post_len;
+      const bool post = near_commissure(x, post_len);
       out.points.push_back(p_.base + x);
       out.normals.push_back(normal);
       out.areas.push_back(width * dx);
@@ -847,6 +844,12 @@ std::vector<Vec3> AorticRoot::post_points(double dx) const {
     }
   }
   return post;
+}
+
+bool AorticRoot::near_commissure(const Vec3& x, double reach) const {
+  for (int c = 0; c < 3 && reach > 0.0; ++c)
+    if ((x - commissure_point(c)).norm() < reach) return true;
+  return false;
 }
 
 Vec3 AorticRoot::commissure_point(int c) const {

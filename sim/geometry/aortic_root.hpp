@@ -194,6 +194,8 @@ class AorticRoot {
  private:
   double midline_length(double sag) const;
   ShapeSample leaflet_shell_uncached(int k, double dx) const;
+  // Whether x (root frame) is within `reach` of a commissure's top point (the commissure posts' clamp).
+  bool near_commissure(const Vec3& x, double reach) const;
   // Appends leaflet k's lunula (lunula_height > 0) to its sheet `out`: columns dx apart straight up from the
   // free-edge particles (row_of: leaflet_mid_surface's rows; kept: the mid-surface points that out holds, in
   // order).
