@@ -360,7 +360,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   if (o.threads > 0) set_threads(o.threads);
   const int threads = max_threads();
   const long outputs = static_cast<long>(std::floor(scene.t_end / scene.output_interval + 1e-9));
-  const int first_frame = record ? record->frames : 0;
+  int first_frame = record ? record->frames : 0;
   const bool render = !o.no_render && !scene.render.cameras.empty();
   check_resources(scene, dir, outputs + 1 - first_frame + (scene.t_end > outputs * scene.output_interval),
                   render, o.vtk ? o.vtk_every : 0);
@@ -380,6 +380,14 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     throw InputError(dir.string() + ": the checkpoint is at t = " + format_number(world.time()) +
                      " s, past the end " + format_number(scene.t_end) +
                      " s (resume --end-time T with T later)");
+  if (resume && world.time() < scene.t_end) {
+    // A run that ended between two outputs wrote a last row and frame at its end, off the grid of
+    // k * output_interval. Run on to a later end, that output is dropped (its row, and its frame number is
+    // the next grid output's), so that frame k stays at t = k * output_interval and the rows match the
+    // frames: the outputs are those of one run to the new end.
+    const int on_grid = static_cast<int>(std::floor(world.time() / scene.output_interval + 1e-9)) + 1;
+    if (first_frame > on_grid) first_frame = on_grid;
+  }
   std::optional<CsvWriter> probe_csv, diag_csv;
   std::optional<VtkWriter> vtk;
   std::optional<std::ofstream> put_backs;  // scenes with shells
@@ -481,6 +489,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
 
   // A checkpoint counts only what is on disk: the frames pushed so far are written first (the CSV rows are
   // flushed row by row). Written atomically, so a kill at any moment leaves the previous or this one.
+  double checkpoint_time = -1.0;  // the time of the last checkpoint this run wrote
   auto write_checkpoint = [&]() {
     if (frames) frames->flush();
     rec.frames = frame;
@@ -495,6 +504,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     rec.save(out);
     world.save_state(out);
     out.write_file(dir / kCheckpointFile);
+    checkpoint_time = world.time();
   };
 
   auto write_run_json = [&](const std::string& status, const std::string& message) {
@@ -571,6 +581,11 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     }
     progress.done();
     if (frames) frames->finish();
+    // A run that writes checkpoints, or a resumed one, leaves one of its end state: its run.json names the
+    // scene as run (time.end included), and `resume --end-time` runs it on from its end, not from an earlier
+    // checkpoint (an older checkpoint of a resumed run would describe another time.end than run.json).
+    if (!g_interrupted && (rec.checkpoint_every > 0.0 || resume) && checkpoint_time != world.time())
+      write_checkpoint();
     if (g_interrupted) {
       // SIGINT / SIGTERM: the step in hand is finished, the frames in the queue are written, then the state.
       write_checkpoint();

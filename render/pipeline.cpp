@@ -225,8 +225,9 @@ void FramePipeline::write_figures() {
       if (camera.name != fig.camera || field == "material" || !camera_ranges_[c]) continue;
       const std::pair<double, double>& range = *camera_ranges_[c];
       const auto unit = units_.find(field);
+      // A resumed run that renders nothing new (resumed at its end) has seen no snapshot: the field's unit.
       bar = ColorBar{settings_.colormap_of(camera), range.first, range.second, field,
-                     unit != units_.end() ? unit->second : std::string()};
+                     unit != units_.end() ? unit->second : std::string(field_unit(field))};
     }
     std::vector<FigurePanel> panels;
     for (double t : fig.times) {

@@ -1194,17 +1194,14 @@ Snapshot World::snapshot(const std::vector<std::string>& fields, int frame) cons
     SnapshotField& f = s.fields.emplace_back();
     f.name = field;
     f.values.resize(n, 0.0f);
+    f.unit = field_unit(field);
     if (field == "speed") {
-      f.unit = "m/s";
       for (std::size_t i = 0; i < n; ++i) f.values[i] = static_cast<float>(P_.v[i].norm());
     } else if (field == "pressure") {
-      f.unit = "Pa";
       for (std::size_t i = 0; i < n; ++i) f.values[i] = static_cast<float>(P_.p[i]);
     } else if (field == "displacement") {
-      f.unit = "m";
       for (std::size_t i = 0; i < n; ++i) f.values[i] = static_cast<float>((P_.x[i] - P_.x0[i]).norm());
-    } else if (field == "stress") {
-      f.unit = "Pa";  // von Mises stress of elastic particles; zero elsewhere
+    } else if (field == "stress") {  // von Mises stress of elastic particles; zero elsewhere
       for (std::size_t k = 0; k < solids_.size(); ++k)
         f.values[solids_.at(k)] = static_cast<float>(solids_.von_mises(k));
       for (std::size_t k = 0; k < shells_.size(); ++k)  // shells: the largest over the Gauss points

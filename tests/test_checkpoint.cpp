@@ -417,6 +417,55 @@ TEST_CASE("checkpoint: resume --end-time runs a finished run on to a later end, 
   CHECK(slurp(out / "run.json").find("\"end\": 0.06") != std::string::npos);
 }
 
+TEST_CASE("checkpoint: a run that ended between two outputs runs on with the output grid, resumable again",
+          "[checkpoint][cli]") {
+  // Outputs every 0.004 s: a run to 0.01 writes its last row and frame at 0.01, off the grid. Run on to
+  // 0.014 and then to 0.02, the outputs are those of one run: t = 0, 0.004, ..., with the 0.01 and 0.014 ends
+  // dropped. (Until stop 60 the resume skipped the grid time 0.012, one to before the next grid time did
+  // nothing, and a resumed run left its older checkpoint, which the next resume refused: run.json named
+  // another end.)
+  const fs::path scene = scene_file();
+  const Outputs& ref = reference(scene);
+  const fs::path out = scratch("off_grid");
+  std::string err;
+  REQUIRE(run_cli("run " + scene.string() + " --quiet --end-time 0.01 --checkpoint-every 0.01 --out " +
+                      out.string(),
+                  &err) == 0);
+  auto times = [&] {
+    std::vector<double> t;
+    std::istringstream in(slurp(out / "probes.csv"));
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) t.push_back(std::stod(line.substr(0, line.find(','))));
+    return t;
+  };
+  CHECK(times() == std::vector<double>{0, 0.004, 0.008, 0.01});
+  REQUIRE(run_cli("resume " + out.string() + " --quiet --end-time 0.014", &err) == 0);
+  CHECK(times() == std::vector<double>{0, 0.004, 0.008, 0.012, 0.014});
+  INFO(err);  // the second resume: from the end at 0.014 (no checkpoint was due there)
+  REQUIRE(run_cli("resume " + out.string() + " --quiet --end-time 0.02", &err) == 0);
+  const std::vector<double> t = times();
+  REQUIRE(t.size() == 6);
+  for (std::size_t k = 0; k < t.size(); ++k) CHECK(std::abs(t[k] - 0.004 * static_cast<double>(k)) < 1e-12);
+  const Outputs got = outputs_of(out);
+  CHECK(got.frames.size() == 6);  // frame k at t = k * 0.004, no frame left from the earlier ends
+  // Up to the first end the run is the uninterrupted one, bitwise (the header and rows 0, 0.004, 0.008).
+  auto head = [](const std::string& csv, int rows) {
+    std::size_t at = 0;
+    for (int k = 0; k <= rows; ++k) at = csv.find('\n', at) + 1;
+    return csv.substr(0, at);
+  };
+  CHECK(head(got.probes, 3) == head(ref.probes, 3));
+  for (std::size_t k = 0; k < 3; ++k) CHECK(got.frames[k] == ref.frames[k]);
+  // The run left a checkpoint of its end: resumed there it has nothing to do and leaves every output as it
+  // was, the figure's colour bar included (its unit came from the rendered frames until stop 60).
+  REQUIRE(run_cli("resume " + out.string() + " --quiet", &err) == 0);
+  const Outputs again = outputs_of(out);
+  CHECK(again.probes == got.probes);
+  CHECK(again.frames == got.frames);
+  CHECK(again.figure == got.figure);
+}
+
 TEST_CASE("checkpoint: resume keeps --end-time (figure times beyond it) and --vtk-every",
           "[checkpoint][cli]") {
   const fs::path scene = scene_file();

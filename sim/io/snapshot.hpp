@@ -36,6 +36,14 @@ struct SnapshotField {
   std::vector<float> values;  // n values
 };
 
+// The unit of a field cameras colour by (SnapshotField::unit; the colour bar's label), "" for none.
+inline const char* field_unit(const std::string& field) {
+  if (field == "speed") return "m/s";
+  if (field == "pressure" || field == "stress") return "Pa";
+  if (field == "displacement") return "m";
+  return "";
+}
+
 struct Snapshot {
   double time = 0.0;
   int frame = 0;                      // output index k: time = k * output_interval
