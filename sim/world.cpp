@@ -967,6 +967,11 @@ void World::save_state(StateWriter& out) const {
   SectionWriter& sh = out.section("shells", 1);
   sh.array(shells_.directors());
   sh.array(shells_.omegas());
+  if (!shells_.empty()) {  // the last update's inputs (Shells::restore_update): a section of its own
+    SectionWriter& su = out.section("shell_update", 1);
+    su.array(shells_.update_positions());
+    su.array(shells_.update_directors());
+  }
   if (shells_.stiffens()) {  // a section of its own: only stiffening (Lee-Sacks) shells have it
     SectionWriter& sf = out.section("shell_stiffening", 1);
     sf.array(shells_.stiffening());
@@ -1167,7 +1172,18 @@ void World::load_state(const StateReader& in) {
   }
   if (!shells_.empty()) {
     shells_.reindex(P_);
-    shells_.update(P_);
+    if (in.has("shell_update")) {  // the last update again, from its own positions and directors
+      SectionReader su = in.section("shell_update");
+      std::vector<Vec3> x, d;
+      su.array(x, "shell update positions", shells_.size());
+      su.array(d, "shell update directors", shells_.size());
+      su.done();
+      if (x.size() != shells_.size()) su.mismatch("shell update positions", x.size(), shells_.size());
+      if (d.size() != shells_.size()) su.mismatch("shell update directors", d.size(), shells_.size());
+      shells_.restore_update(x, d);
+    } else {  // older checkpoints: from the positions now (the resumed run differs in the last digits)
+      shells_.update(P_);
+    }
     if (!stiffening.empty()) shells_.stiffening() = stiffening;
   }
 }

@@ -254,8 +254,21 @@ Vec3 Shells::normal(std::size_t s) const {
 }
 
 void Shells::update(const Particles& P) {
+  parallel_for(X_.size(), [&](std::size_t s) { x_[s] = P.x[at_[s]]; });
+  compute();
+}
+
+void Shells::restore_update(const std::vector<Vec3>& x, const std::vector<Vec3>& d) {
+  x_ = x;
+  std::vector<Vec3> now = d;
+  d_.swap(now);  // compute() reads d_: the directors of that update, then the current ones back
+  compute();
+  d_.swap(now);
+}
+
+void Shells::compute() {
   const std::size_t n = X_.size();
-  parallel_for(n, [&](std::size_t s) { x_[s] = P.x[at_[s]]; });
+  d_update_ = d_;
   // Mid-surface tangents and director gradient.
   parallel_for(n, [&](std::size_t s) {
     Mat32 G = Mat32::Zero(), H = Mat32::Zero();

@@ -80,6 +80,12 @@ class Shells {
   // Resultants, energy, forces and director moments from the current positions and directors; adds the
   // internal forces to f (indexed like P).
   void update(const Particles& P);
+  // Checkpoint: the positions (by slot) and directors the last update() computed from, and that update
+  // again from them (a resumed run then reads the same normals, stresses and forces before its first
+  // update as the saved run did: they lag the positions by the last sub-step's drift).
+  const std::vector<Vec3>& update_positions() const { return x_; }
+  const std::vector<Vec3>& update_directors() const { return d_update_; }
+  void restore_update(const std::vector<Vec3>& x, const std::vector<Vec3>& d);
   void add_forces(std::vector<Vec3>& f) const;
   // Director update: omega += kick (tau / I - c omega), d <- R(omega dt) d. Supports hold their director.
   void advance_directors(double dt, double kick);
@@ -218,7 +224,9 @@ class Shells {
   std::vector<Vec3> d_, omega_;
   std::vector<Vec3> external_, free_axis_;  // empty unless set (tests, validations)
   // Per update.
-  std::vector<Vec3> x_;  // positions gathered by slot
+  std::vector<Vec3> x_;         // positions gathered by slot
+  std::vector<Vec3> d_update_;  // the directors compute() used
+  void compute();               // update() from x_ and d_
   std::vector<Mat32> G_, H_, PG_, PH_;
   std::vector<Vec3> q_, hg_force_, force_, torque_;
   std::vector<Mat3> F0_;
