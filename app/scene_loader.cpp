@@ -330,7 +330,8 @@ class Loader {
             "stj_height",     "aorta_radius",   "lvot_length",       "aorta_length",      "leaflet_free_edge",
             "leaflet_height", "leaflet_layers", "wall_layers",       "commissure_angles", "sinuses",
             "leaflet_shape",  "mirror_tilt",    "graft_diameter",    "graft_shape",       "neo_sinus_bulge",
-            "stj_diameter",   "cusps",          "commissure_post",   "lunula_height",     "lunula_material"};
+            "stj_diameter",   "cusps",          "commissure_post",   "lunula_height",     "lunula_material",
+            "lunula_radius"};
   }
 
   // Reads the aortic_root parameters that o holds over p; with fill, every parameter, defaults written into
@@ -367,6 +368,7 @@ class Loader {
     if (o.has("commissure_post")) p.commissure_post = o.non_negative("commissure_post");
     if (o.has("lunula_height")) p.lunula_height = o.non_negative("lunula_height");
     if (o.has("lunula_material")) p.lunula_material = o.string("lunula_material");
+    if (o.has("lunula_radius")) p.lunula_radius = o.non_negative("lunula_radius");
     surgical_params(o, p);
   }
 

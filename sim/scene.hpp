@@ -142,6 +142,9 @@ struct AorticRootParams {
   // [m] above its closure line at the centre, as a band on the leaflet's side of its coaptation planes,
   // tapering to nothing at the commissures. 0: none (the free edge is the closure line).
   double lunula_height = 0.0;
+  // The radius [m] over which the lunula tapers, h (1 - (r / lunula_radius)^2) at radius r along the free
+  // edge, none beyond; 0: commissure_radius (the whole free edge).
+  double lunula_radius = 0.0;
   // The lunula's material (a shell material's name; empty: the leaflet's): a real lunula is thinner than the
   // belly, and a lunula as stiff as the leaflet stands on its free edge like a rib (docs/scenes.md,
   // "Lunula").

@@ -367,6 +367,49 @@ TEST_CASE("shell leaflets: the lunula stands on the free edges, in the planes be
   CHECK(blood_gap >= 0.5 * dx);
 }
 
+TEST_CASE("shell leaflets: a lunula_radius keeps the lunula to the centre, tapering to it",
+          "[shell_leaflet]") {
+  // h (1 - (r / r_l)^2) with r_l = 6 mm instead of commissure_radius (12 mm): the band is the full band's
+  // columns cut to the smaller taper, none beyond r_l; the sheet is unchanged (the closed valve keeps its
+  // central coaptation and opens nearly as without a lunula: docs/validation.md, stop 60).
+  const double dx = 0.001, h = 0.004, rl = 0.006;
+  AorticRootParams full = mirror();
+  full.lunula_height = h;
+  AorticRootParams cut = full;
+  cut.lunula_radius = rl;
+  REQUIRE_FALSE(check_aortic_root(cut, dx));
+  const AorticRoot a(full), b(cut);
+  AorticRootParams none = mirror();
+  const std::size_t n0 = AorticRoot(none).leaflet_shell(1, dx).points.size();
+  const ShapeSample sa = a.leaflet_shell(1, dx), sb = b.leaflet_shell(1, dx);
+  REQUIRE(sb.points.size() > n0 + 10);
+  REQUIRE(sb.points.size() < sa.points.size() - 20);
+  CHECK(
+      std::equal(sb.points.begin(), sb.points.begin() + static_cast<std::ptrdiff_t>(n0), sa.points.begin()));
+  auto radius = [&](const Vec3& x) { return std::hypot(x.x() - full.base.x(), x.z() - full.base.z()); };
+  // Each band particle of the cut lunula is one of the full band's, inside r_l; each of the full band's
+  // within the cut taper (its height above its column's foot) is in the cut band.
+  double widest = 0.0;
+  std::size_t kept = 0;
+  for (std::size_t i = n0; i < sa.points.size(); ++i) {
+    const Vec3& x = sa.points[i];
+    const double r = radius(x);
+    double foot = 1e300;  // the free-edge particle below it
+    for (std::size_t j = 0; j < n0; ++j)
+      if (std::hypot(sa.points[j].x() - x.x(), sa.points[j].z() - x.z()) < 1e-12)
+        foot = std::min(foot, x.y() - sa.points[j].y());
+    const bool in_cut = r < rl && foot <= h * (1.0 - r * r / (rl * rl)) + 1e-12;
+    bool found = false;
+    for (std::size_t j = n0; j < sb.points.size() && !found; ++j) found = (sb.points[j] - x).norm() < 1e-12;
+    INFO("r " << r << " m, " << foot << " m above the edge");
+    CHECK(found == in_cut);
+    if (found) widest = std::max(widest, r), ++kept;
+  }
+  CHECK(kept == sb.points.size() - n0);
+  CHECK(widest < rl);
+  CHECK(widest > rl - 2.5 * dx);
+}
+
 namespace {
 
 std::string replaced(std::string s, const std::string& from, const std::string& to) {
@@ -513,6 +556,11 @@ TEST_CASE("shell leaflets: the scene loader builds shell bodies, bad input exits
        "aortic_root.lunula_material: 'tissue' is not a shell material"},
       {"lunula material without a lunula", mirror_valve("\"lunula_material\": \"leaf\""),
        "aortic_root.lunula_material: there is no lunula"},
+      {"lunula radius without a lunula", mirror_valve("\"lunula_radius\": 0.005"),
+       "aortic_root.lunula_radius: needs lunula_height"},
+      {"lunula radius beyond the commissures",
+       mirror_valve("\"lunula_height\": 0.003, \"lunula_radius\": 0.02"),
+       "aortic_root.lunula_radius: 0.02 is beyond the commissures"},
   };
   for (const Row& r : rows) {
     std::ofstream(dir / "scene.json") << r.scene;

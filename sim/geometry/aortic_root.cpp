@@ -753,7 +753,8 @@ void AorticRoot::add_lunula(int k, double dx, const std::vector<int>& row_of,
   };
   auto column = [&](std::size_t j, const Vec3& normal, const Vec3& fibre, double width) {
     const Vec3 q = out.points[j] - p_.base;
-    const double f = std::min(1.0, std::hypot(q.x(), q.z()) / p_.commissure_radius);
+    const double rl = p_.lunula_radius > 0.0 ? p_.lunula_radius : p_.commissure_radius;
+    const double f = std::min(1.0, std::hypot(q.x(), q.z()) / rl);
     const double w = p_.lunula_height * (1.0 - f * f);
     for (int i = 1; i * dx <= w * (1.0 + 1e-9); ++i) {
       const Vec3 x = q + Vec3(0.0, i * dx, 0.0);
@@ -1009,6 +1010,11 @@ std::optional<AorticRootError> check_resolved(const AorticRootParams& p, double 
   if (p.lunula_height > 0.0 && !(p.lunula_height < 0.5 * p.commissure_height))
     return err("lunula_height", num(p.lunula_height) + " is too high (less than commissure_height / 2 = " +
                                     num(0.5 * p.commissure_height) + ")");
+  if (p.lunula_radius > 0.0 && !(p.lunula_height > 0.0)) return err("lunula_radius", "needs lunula_height");
+  if (p.lunula_radius > p.commissure_radius)
+    return err("lunula_radius", num(p.lunula_radius) +
+                                    " is beyond the commissures (at most commissure_radius = " +
+                                    num(p.commissure_radius) + ")");
   // Labrosse leaflets follow free_edge and leaflet_height; mirror leaflets follow the root alone.
   if (!p.mirror_leaflets) {
     if (p.leaflet_free_edge < 2.0 * p.commissure_radius)

@@ -65,8 +65,9 @@
 //  * Lunula (shell leaflets, lunula_height h > 0): each leaflet's free margin stands above the closure line,
 //    as in a real valve, whose cusps overlap there by the coaptation height. Columns of particles dx apart
 //    rise straight up from the sheet's free-edge particles, in the plane dx/2 inside the sector beside each
-//    coaptation plane (where the free edge runs), h (1 - (r / commissure_radius)^2) high at radius r, with
-//    the normal across the band into the sector (the aortic side); the sheet itself is unchanged.
+//    coaptation plane (where the free edge runs), h (1 - (r / r_l)^2) high at radius r (r_l: lunula_radius,
+//    by default commissure_radius; none beyond), with the normal across the band into the sector (the aortic
+//    side); the sheet itself is unchanged.
 //  * Wall: rings of particles at y levels (spaced dx, closer where the sinus wall is steep, so spacing along
 //    the wall stays <= dx), each ring wall_layers deep, layer j at R + (j + 1/2) dx (scaled by the wall's
 //    slope so the layers are dx apart along the normal); rings and layers staggered by half a spacing; ends
