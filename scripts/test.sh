@@ -10,7 +10,8 @@
 # ThreadSanitizer and the Release step check, and the light-sheet barrier case, 16 s; at stop 45 the
 # deep-buffer list audit, 30 s, the pressure inlet beside an off-lattice wall, 26 s, the soft blocks' contact,
 # 15 s, and the barrier beside a free edge's plane, 13 s, CI having taken 936 s; at stop 55 the resume to a
-# later end, 13 s),
+# later end, 13 s; at stop 60 the mask_density sluice, 55 s, whose 28 ms start covers the code, CI having taken
+# 976 s),
 # each while other cases cover its code under the sanitizers; they all run in the Release step), a
 # ThreadSanitizer build runs the simulation-render pipeline test, a bounded libFuzzer run
 # fuzzes the scene loader (scripts/fuzz.sh, built in the same clang sanitizer tree), then the Release build (GCC)
