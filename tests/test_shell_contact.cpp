@@ -379,6 +379,47 @@ TEST_CASE(
   CHECK(gmax > 0.0);
 }
 
+TEST_CASE("shell contact: a wall reaching a free edge edge-on pushes the edge back, coming in continuously",
+          "[shell_contact]") {
+  // The sheet and block of the case above, the block brought towards the +x edge row (x = 4.5 mm) in
+  // steps of 0.01 mm, its first column from 0.75 to 0.55 mm beyond the row, its middle layer in the sheet's
+  // plane: its particles' feet enter the edge particles' patches (reach dx / sqrt(2) = 0.707 mm) edge on.
+  // Until stop 60 the plane's gap (~0) set a barrier along the normal at once (1000 K edge on; 48 MPa, 10 N
+  // on one particle of the physio valve's lunula at the sinotubular junction, which then moved at 105 m/s).
+  // Now the edge particle's patch is a disc of radius dx / 2: the gap is the distance from its rim, the
+  // force along the rim-to-wall direction (in the plane: the edge is pushed back, -x), and the weight rises
+  // from 0 at the reach.
+  const ShellContact contact({kK, -1.0, 0.5, kDx}, 2.6 * kDx);
+  std::vector<double> fx, fz, fmax;
+  for (int k = 0; k <= 20; ++k) {
+    const double x0 = 4.75e-3 - 1e-5 * k;  // the first column at x0 + dx / 2
+    Scene s = base_scene();
+    s.materials = {sheet_material(0.0), wall()};
+    s.bodies = {plate("sheet", 0, Vec3(0, 0, 0), 10 * kDx, 10 * kDx, Vec3::UnitZ()),
+                box_body("block", 1, Vec3(x0, -0.005, -1.5e-3), Vec3(x0 + 2e-3, 0.005, 1.5e-3))};
+    World w(s);
+    const Particles& P = w.particles();
+    std::vector<Vec3> f(P.size(), Vec3::Zero());
+    contact.add_forces(P, w.neighbors(), w.shells(), Periodic(), f);
+    Vec3 total = Vec3::Zero();
+    double largest = 0.0;
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (P.kind[i] == Kind::Shell) total += f[i], largest = std::max(largest, f[i].norm());
+    fx.push_back(total.x());
+    fz.push_back(total.z());
+    fmax.push_back(largest);
+  }
+  INFO("force on the sheet, 0.75 mm: " << fx.front() << " N along x; 0.70 mm: " << fx[5]
+                                       << "; 0.55 mm: " << fx.back() << " along x, " << fz.back()
+                                       << " along z; largest on one " << fmax.back() << " N");
+  CHECK(fmax.front() < 1e-12);                              // beyond the patches
+  CHECK(fx.back() < 0.0);                                   // pushed back, away from the block
+  CHECK(std::abs(fz.back()) < 1e-9 * std::abs(fx.back()));  // not sideways
+  // Continuously: just inside the reach a small force, and it grows as the block comes nearer.
+  CHECK(fmax[5] < 0.02 * fmax.back());
+  for (std::size_t k = 1; k < fx.size(); ++k) CHECK(fx[k] <= fx[k - 1]);
+}
+
 TEST_CASE(
     "shell contact: a wall particle in the tangent plane of a far particle of a curved sheet meets the "
     "sheet's own gap, on either side of that plane",

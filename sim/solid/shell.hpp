@@ -117,6 +117,7 @@ class Shells {
   // sheet every nearby point does (true at once); near an edge (the two or three rows whose reference
   // neighbourhood's first moment, sum_t W (X_t - X_s) / sum_t W, exceeds 0.08 of the neighbours' mean
   // distance, about 0.1 dx: the fluid coupling's test) a point beyond the edge does not.
+  bool near_edge(std::size_t s) const { return edge_[s] != 0; }
   bool over_sheet(std::size_t s, const Vec3& r, double reach) const {
     if (!edge_[s]) return true;
     const double r2 = reach * reach;

@@ -17,7 +17,10 @@
 //     proportion to the squares of the two gaps (half each for parallel sheets; edge on, the edge
 //     particle's own plane, which holds the partner at a gap near 0 and says nothing about the contact,
 //     gets no share), so the pair force is symmetric in the two; a shell particle and a wall or elastic
-//     particle act through the shell's plane only (volumetric particles have no normal);
+//     particle act through the shell's plane only (volumetric particles have no normal), except near an
+//     edge, where the edge particle's patch is a disc of radius dx / 2 and a partner beyond its rim is
+//     pushed from the rim (edge on: in the plane), the pair's weight rising from 0 at the patches' reach
+//     dx / sqrt(2) (stop 60);
 //   - a barrier law, p = K (d_c / s - 1) for 0 < s < d_c (d_c the contact distance), which grows without
 //     bound as the gap closes: no load can press two sheets through each other, and at a pressure p the
 //     gap is s = d_c K / (K + p) (K = 100 p gives d_c within 1 %). Its stiffness per area K d_c / s^2 sets
