@@ -1180,11 +1180,11 @@ void World::load_state(const StateReader& in) {
       su.done();
       if (x.size() != shells_.size()) su.mismatch("shell update positions", x.size(), shells_.size());
       if (d.size() != shells_.size()) su.mismatch("shell update directors", d.size(), shells_.size());
-      shells_.restore_update(x, d);
+      shells_.restore_update(std::move(x), std::move(d));  // the stiffening of that update too
     } else {  // older checkpoints: from the positions now (the resumed run differs in the last digits)
       shells_.update(P_);
+      if (!stiffening.empty()) shells_.stiffening() = stiffening;
     }
-    if (!stiffening.empty()) shells_.stiffening() = stiffening;
   }
 }
 

@@ -258,12 +258,11 @@ void Shells::update(const Particles& P) {
   compute();
 }
 
-void Shells::restore_update(const std::vector<Vec3>& x, const std::vector<Vec3>& d) {
-  x_ = x;
-  std::vector<Vec3> now = d;
-  d_.swap(now);  // compute() reads d_: the directors of that update, then the current ones back
+void Shells::restore_update(std::vector<Vec3> x, std::vector<Vec3> d) {
+  x_ = std::move(x);
+  d_.swap(d);  // compute() reads d_: the directors of that update, then the current ones back
   compute();
-  d_.swap(now);
+  d_.swap(d);
 }
 
 void Shells::compute() {

@@ -85,7 +85,7 @@ class Shells {
   // update as the saved run did: they lag the positions by the last sub-step's drift).
   const std::vector<Vec3>& update_positions() const { return x_; }
   const std::vector<Vec3>& update_directors() const { return d_update_; }
-  void restore_update(const std::vector<Vec3>& x, const std::vector<Vec3>& d);
+  void restore_update(std::vector<Vec3> x, std::vector<Vec3> d);
   void add_forces(std::vector<Vec3>& f) const;
   // Director update: omega += kick (tau / I - c omega), d <- R(omega dt) d. Supports hold their director.
   void advance_directors(double dt, double kick);
