@@ -267,6 +267,8 @@ struct RunRecord {
   // --end-time: the end the run uses and the scene file's own (figures are validated against the latter).
   double end_override = 0.0, file_end = 0.0;
   int32_t frames = 0;
+  // Rows of probes.csv and diagnostics.csv (section "rows"; a checkpoint without it wrote a row per frame).
+  int32_t rows = 0;
   std::optional<std::pair<double, double>> range;
   // Per camera (name, range): cameras may colour by their own field, colormap or hidden bodies (section
   // "camera_ranges"; a checkpoint without it was written before cameras had overrides).
@@ -291,6 +293,7 @@ struct RunRecord {
     w.value(range ? range->first : 0.0);
     w.value(range ? range->second : 0.0);
     out.section("vtk_every", 1).value(vtk_every);
+    out.section("rows", 1).value(rows);
     SectionWriter& c = out.section("camera_ranges", 1);
     c.value(static_cast<uint64_t>(camera_ranges.size()));
     for (const auto& [name, r] : camera_ranges) {
@@ -331,6 +334,14 @@ struct RunRecord {
       v.done();
       if (rec.vtk_every < 1) throw InputError(file.string() + ": a VTK stride below 1 (damaged checkpoint)");
     }
+    rec.rows = rec.frames;
+    if (in.has("rows")) {
+      SectionReader v = in.section("rows");
+      rec.rows = v.value<int32_t>();
+      v.done();
+      if (rec.rows < rec.frames)
+        throw InputError(file.string() + ": fewer rows than frames (damaged checkpoint)");
+    }
     if (in.has("camera_ranges")) {
       SectionReader c = in.section("camera_ranges");
       const auto count = c.value<uint64_t>();
@@ -360,7 +371,12 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   if (o.threads > 0) set_threads(o.threads);
   const int threads = max_threads();
   const long outputs = static_cast<long>(std::floor(scene.t_end / scene.output_interval + 1e-9));
+  // Probe rows at j * probe_interval, a whole number `per_output` of them per output interval: row j is frame
+  // j / per_output where that divides, and the end off the grid has a row and a frame.
+  const long per_output = std::max(1L, std::lround(scene.output_interval / scene.probe_interval));
+  const long rows_on_grid = static_cast<long>(std::floor(scene.t_end / scene.probe_interval + 1e-9));
   int first_frame = record ? record->frames : 0;
+  int first_row = record ? record->rows : 0;
   const bool render = !o.no_render && !scene.render.cameras.empty();
   check_resources(scene, dir, outputs + 1 - first_frame + (scene.t_end > outputs * scene.output_interval),
                   render, o.vtk ? o.vtk_every : 0);
@@ -387,6 +403,8 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     // frames: the outputs are those of one run to the new end.
     const int on_grid = static_cast<int>(std::floor(world.time() / scene.output_interval + 1e-9)) + 1;
     if (first_frame > on_grid) first_frame = on_grid;
+    const int rows_on = static_cast<int>(std::floor(world.time() / scene.probe_interval + 1e-9)) + 1;
+    if (first_row > rows_on) first_row = rows_on;
   }
   std::optional<CsvWriter> probe_csv, diag_csv;
   std::optional<VtkWriter> vtk;
@@ -394,8 +412,8 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   if (!world.shells().empty())
     put_backs = open_put_backs(dir / "shell_putbacks.csv", resume ? world.time() : -1.0);
   if (resume) {
-    probe_csv.emplace(dir / "probes.csv", probes.columns(), first_frame);
-    diag_csv.emplace(dir / "diagnostics.csv", diagnostics_columns(), first_frame);
+    probe_csv.emplace(dir / "probes.csv", probes.columns(), first_row);
+    diag_csv.emplace(dir / "diagnostics.csv", diagnostics_columns(), first_row);
     if (o.vtk) vtk.emplace(dir / "vtk", first_frame, o.vtk_every);
   } else {
     probe_csv.emplace(dir / "probes.csv", probes.columns());
@@ -453,8 +471,9 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     cycles_reported = cycles.size();
   }
 
-  int frame = first_frame;
-  auto output = [&]() {
+  int frame = first_frame, rows_done = first_row;
+  // A row of probes.csv and diagnostics.csv; with `with_frame`, the frame and VTK file of this output too.
+  auto output = [&](bool with_frame) {
     std::vector<double> row{world.time()};
     const auto values = probes.measure(world);
     row.insert(row.end(), values.begin(), values.end());
@@ -465,9 +484,11 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
         next_cycle_end += scene.cycle->period;
       update_cycles();
     }
+    ++rows_done;
+    if (!with_frame) return;
     // --vtk-every N: frames 0, N, 2N, ... and the last output (the end state, which a study's stress map
     // reads).
-    if (vtk && (frame % o.vtk_every == 0 || world.time() >= scene.t_end - 1e-9 * scene.output_interval))
+    if (vtk && (frame % o.vtk_every == 0 || world.time() >= scene.t_end - 1e-9 * scene.probe_interval))
       vtk->write(world, frame);
     if (frames) frames->push(world, frame);
     ++frame;
@@ -493,6 +514,7 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   auto write_checkpoint = [&]() {
     if (frames) frames->flush();
     rec.frames = frame;
+    rec.rows = rows_done;
     rec.range = frames ? frames->field_range() : std::nullopt;
     rec.camera_ranges.clear();
     if (frames) {
@@ -518,13 +540,14 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
     j["scene_file"] = rec.scene_file;
     j["sets"] = o.sets;
     if (o.checkpoint_every) j["checkpoint_every"] = *o.checkpoint_every;
-    if (resume) j["resumed_at"] = {{"time", world.time()}, {"frame", first_frame}};
+    if (resume) j["resumed_at"] = {{"time", world.time()}, {"frame", first_frame}, {"row", first_row}};
     j["particles"] = {{"total", world.particles().size()},
                       {"fluid", world.count(Kind::Fluid)},
                       {"boundary", world.particles().size() - world.count(Kind::Fluid)}};
     j["time"] = {{"simulated", world.time()},
                  {"steps", world.steps()},
                  {"frames", frame},
+                 {"probe_rows", rows_done},
                  {"neighbour_list_builds", world.list_builds()}};
     if (!world.shells().empty())  // fluid particles put back on their side of a sheet (0 when it holds)
       j["shells"] = {{"particles", world.shells().size()},
@@ -557,11 +580,15 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
   int code = 0;
   try {
     write_run_json("running", "");
-    if (!resume) output();
-    // Outputs at exactly k * output_interval (SPEC section 2), then at t_end if that is not one of them.
-    // Output k is frame k, so a resumed run continues at k = the frames already written.
-    for (long k = std::max(1, first_frame); k <= outputs + 1 && !g_interrupted; ++k) {
-      const double target = k <= outputs ? static_cast<double>(k) * scene.output_interval : scene.t_end;
+    if (!resume) output(true);
+    // Outputs at exactly k * output_interval (SPEC section 2), probe rows at exactly j * probe_interval
+    // between them, then at t_end if that is not one of them. Row j is the j-th row, so a resumed run
+    // continues at j = the rows already written.
+    for (long j = std::max(1, first_row); j <= rows_on_grid + 1 && !g_interrupted; ++j) {
+      const bool on_frame = j <= rows_on_grid && j % per_output == 0;
+      const double target = j > rows_on_grid ? scene.t_end
+                            : on_frame       ? static_cast<double>(j / per_output) * scene.output_interval
+                                             : static_cast<double>(j) * scene.probe_interval;
       if (target <= world.time()) break;
       const bool reached = world.advance_to(target, [&] {
         progress.update(world);
@@ -569,7 +596,8 @@ int execute(LoadedScene loaded, const RunOptions& o, const std::filesystem::path
         return !g_interrupted.load();
       });
       if (!reached) break;  // interrupted between outputs: no partial row, everything before stays valid
-      output();
+      // The end has a frame, on the grid of outputs or not.
+      output(on_frame || target >= scene.t_end - 1e-9 * scene.probe_interval);
       if (cycles_changed) {
         write_run_json("running", "");
         cycles_changed = false;
@@ -848,9 +876,11 @@ int cmd_check(const std::filesystem::path& file, const std::vector<std::string>&
                 cycle_windows(scene.t_end, {scene.cycle->period, scene.cycle->start}).size(), scene.t_end,
                 cols.c_str());
   }
-  std::printf("  outputs: %ld (every %g s), probes: %zu, cameras: %zu\n",
+  std::printf("  outputs: %ld (every %g s), probe rows: %ld (every %g s), probes: %zu, cameras: %zu\n",
               static_cast<long>(std::floor(scene.t_end / scene.output_interval + 1e-9)) + 1,
-              scene.output_interval, scene.probes.size(), scene.render.cameras.size());
+              scene.output_interval,
+              static_cast<long>(std::floor(scene.t_end / scene.probe_interval + 1e-9)) + 1,
+              scene.probe_interval, scene.probes.size(), scene.render.cameras.size());
   return 0;
 }
 

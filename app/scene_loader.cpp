@@ -208,7 +208,8 @@ class Loader {
       fail(res.path("smoothing_ratio"), "must lie in 1..3");
 
     Obj time(top.raw("time"), "time",
-             {"end", "output_interval", "cfl", "max_dt", "max_speed", "max_density_error", "fixed_dt"},
+             {"end", "output_interval", "probe_interval", "cfl", "max_dt", "max_speed", "max_density_error",
+              "fixed_dt"},
              allowed);
     // Without time.end, a cycle block with `cycles` sets the run's length (docs/scenes.md "cycle").
     if (!time.has("end") && top.has("cycle")) {
@@ -224,6 +225,19 @@ class Loader {
     s.max_density_error = time.non_negative("max_density_error", 0.5);
     s.fixed_dt = time.non_negative("fixed_dt", 0.0);
     if (s.t_end / s.output_interval > 1e6) fail(time.path("output_interval"), "more than a million outputs");
+    // Probe rows between the frames (docs/scenes.md "time"): a whole number of them per output interval, so
+    // that every frame has its row. Left out, it is output_interval, and stays out of the resolved scene
+    // (a --set of output_interval on the resolved scene moves it too).
+    s.probe_interval = time.has("probe_interval") ? time.positive("probe_interval") : s.output_interval;
+    {
+      const double per_output = s.output_interval / s.probe_interval;
+      if (per_output < 1.0 - 1e-9 || std::abs(per_output - std::round(per_output)) > 1e-6 * per_output)
+        fail(time.path("probe_interval"), json(s.probe_interval).dump() +
+                                              " s must divide time.output_interval " +
+                                              json(s.output_interval).dump() + " s a whole number of times");
+      if (s.t_end / s.probe_interval > 1e6)
+        fail(time.path("probe_interval"), "more than a million probe rows");
+    }
 
     s.pressure_gauge_open =
         top.choice("pressure_gauge", {"open_boundaries", "none"}, "open_boundaries") == "open_boundaries";
@@ -1288,9 +1302,9 @@ class Loader {
       fail(o.path("cycles"), std::to_string(c.cycles) +
                                  " cycles need time.end >= " + json(c.start + c.cycles * c.period).dump() +
                                  " s, got " + json(s.t_end).dump());
-    if (c.period < 4.0 * s.output_interval)
+    if (c.period < 4.0 * s.probe_interval)
       fail(o.path("period"),
-           "must hold at least 4 outputs (time.output_interval " + json(s.output_interval).dump() + " s)");
+           "must hold at least 4 probe rows (time.probe_interval " + json(s.probe_interval).dump() + " s)");
     if (c.start + c.period > s.t_end + 1e-9 * c.period)
       fail(o.path("period"), "time.end " + json(s.t_end).dump() + " s holds no complete cycle (start " +
                                  json(c.start).dump() + " s + period)");

@@ -429,6 +429,9 @@ struct Scene {
   double smoothing_ratio = 1.3;  // h = smoothing_ratio * spacing
   double t_end = 1.0;
   double output_interval = 0.01;
+  // Rows of probes.csv and diagnostics.csv at k * probe_interval; output_interval is a whole multiple of it
+  // (frames and VTK files at every output, a row at each). The loader sets it (default output_interval).
+  double probe_interval = 0.01;
   double cfl = 0.25;
   double max_dt = 1e-3;
   double max_speed = 0.0;          // instability limit [m/s]; 0 = derived from the sound speed

@@ -466,6 +466,46 @@ TEST_CASE("checkpoint: a run that ended between two outputs runs on with the out
   CHECK(again.figure == got.figure);
 }
 
+TEST_CASE("checkpoint: probe rows between the frames (time.probe_interval) resume as one run",
+          "[checkpoint][cli]") {
+  // Rows every 0.002 s, frames every 0.004 s. A run to 0.006 ends on a row, between two frames: it has rows
+  // 0 .. 0.006 and frames at 0, 0.004 and its end. Run on to 0.014, the rows and frames are those of one
+  // run to 0.014: the 0.006 row stays (it is on the rows' grid), the 0.006 frame is dropped, and the end
+  // 0.014 (off the frames' grid) has a frame.
+  const fs::path scene = scene_file();
+  const std::string rows = " --set time.probe_interval=0.002";
+  const fs::path one = scratch("rows_one"), two = scratch("rows_two");
+  std::string err;
+  REQUIRE(run_cli("run " + scene.string() + " --quiet --end-time 0.014" + rows + " --out " + one.string(),
+                  &err) == 0);
+  REQUIRE(run_cli("run " + scene.string() + " --quiet --end-time 0.006 --checkpoint-every 0.006" + rows +
+                      " --out " + two.string(),
+                  &err) == 0);
+  auto times = [](const fs::path& out) {
+    std::vector<double> t;
+    std::istringstream in(slurp(out / "probes.csv"));
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) t.push_back(std::stod(line.substr(0, line.find(','))));
+    return t;
+  };
+  CHECK(times(two) == std::vector<double>{0, 0.002, 0.004, 0.006});
+  CHECK(outputs_of(two).frames.size() == 3);
+  const int code = run_cli("resume " + two.string() + " --quiet --end-time 0.014", &err);
+  INFO(err);
+  REQUIRE(code == 0);
+  const std::vector<double> t = times(one);
+  REQUIRE(t.size() == 8);
+  for (std::size_t k = 0; k < t.size(); ++k) CHECK(std::abs(t[k] - 0.002 * static_cast<double>(k)) < 1e-12);
+  const Outputs a = outputs_of(one), b = outputs_of(two);
+  CHECK(a.frames.size() == 5);  // t = 0, 0.004, 0.008, 0.012 and the end 0.014
+  CHECK(b.probes == a.probes);
+  REQUIRE(b.frames.size() == a.frames.size());
+  for (std::size_t k = 0; k < a.frames.size(); ++k) CHECK(b.frames[k] == a.frames[k]);
+  const std::string diagnostics = slurp(two / "diagnostics.csv");  // a row with each probe row
+  CHECK(std::count(diagnostics.begin(), diagnostics.end(), '\n') == 9);
+}
+
 TEST_CASE("checkpoint: resume keeps --end-time (figure times beyond it) and --vtk-every",
           "[checkpoint][cli]") {
   const fs::path scene = scene_file();
