@@ -219,6 +219,8 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
 
   x_.resize(n);
   G_.assign(n, Mat32::Zero());
+  normal_.assign(n, Vec3::Zero());
+  has_normal_.assign(n, 0);
   H_.assign(n, Mat32::Zero());
   PG_.assign(n, Mat32::Zero());
   PH_.assign(n, Mat32::Zero());
@@ -247,12 +249,6 @@ void Shells::reindex(const Particles& P) {
   map_slots(P, Kind::Shell, s_of_id_, id_, X_, "shell", at_, slot_);
 }
 
-Vec3 Shells::normal(std::size_t s) const {
-  const Vec3 n = G_[s].col(0).cross(G_[s].col(1));
-  const double len = n.norm();
-  return len > 0.0 ? Vec3(n / len) : d_[s];
-}
-
 void Shells::update(const Particles& P) {
   parallel_for(X_.size(), [&](std::size_t s) { x_[s] = P.x[at_[s]]; });
   compute();
@@ -279,6 +275,10 @@ void Shells::compute() {
     if (offset_[s] == offset_[s + 1]) G << T1_[s], T2_[s];
     G_[s] = G;
     H_[s] = H;
+    const Vec3 nrm = G.col(0).cross(G.col(1));
+    const double len = nrm.norm();
+    has_normal_[s] = len > 0.0;
+    normal_[s] = len > 0.0 ? Vec3(nrm / len) : Vec3::Zero();
     F0_[s] = columns(G, d_[s]) * K0_[kGauss * s];
   });
   // Stress at the Gauss points, resultants and the energy's derivatives by G, H and d.

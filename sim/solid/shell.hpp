@@ -110,8 +110,10 @@ class Shells {
   const Vec3& omega(std::size_t s) const { return omega_[s]; }
   double thickness(std::size_t s) const { return params_[material_[s]].t; }
   double rotary_inertia(std::size_t s) const { return inertia_[s]; }
-  // Current mid-surface normal (G column 0 x column 1, normalised; oriented like N).
-  Vec3 normal(std::size_t s) const;
+  // Current mid-surface normal (G column 0 x column 1, normalised; oriented like N), as of the last update;
+  // the director where the tangents vanish. Kept by compute() (the fluid coupling reads it for every triangle
+  // near a fluid particle, several times per sub-step).
+  Vec3 normal(std::size_t s) const { return has_normal_[s] ? normal_[s] : d_[s]; }
   // Whether the point x_s + r (r from the particle's position at the last update()) lies over its sheet:
   // within `reach` of the particle or of one of its reference neighbours, where they are now. Inside a
   // sheet every nearby point does (true at once); near an edge (the two or three rows whose reference
@@ -229,6 +231,8 @@ class Shells {
   std::vector<Vec3> d_update_;  // the directors compute() used
   void compute();               // update() from x_ and d_
   std::vector<Mat32> G_, H_, PG_, PH_;
+  std::vector<Vec3> normal_;         // G column 0 x column 1, normalised
+  std::vector<uint8_t> has_normal_;  // 0 where that cross product vanishes
   std::vector<Vec3> q_, hg_force_, force_, torque_;
   std::vector<Mat3> F0_;
   std::vector<double> energy_, vm_, strain_;
