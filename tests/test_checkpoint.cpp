@@ -268,6 +268,16 @@ fs::path scene_file() {
   return dir / "ckpt.json";
 }
 
+// The time column of OUT/probes.csv.
+std::vector<double> row_times(const fs::path& out) {
+  std::vector<double> t;
+  std::istringstream in(slurp(out / "probes.csv"));
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) t.push_back(std::stod(line.substr(0, line.find(','))));
+  return t;
+}
+
 void check_same(const Outputs& got, const Outputs& ref) {
   CHECK(got.probes == ref.probes);
   REQUIRE(got.frames.size() == ref.frames.size());
@@ -431,14 +441,7 @@ TEST_CASE("checkpoint: a run that ended between two outputs runs on with the out
   REQUIRE(run_cli("run " + scene.string() + " --quiet --end-time 0.01 --checkpoint-every 0.01 --out " +
                       out.string(),
                   &err) == 0);
-  auto times = [&] {
-    std::vector<double> t;
-    std::istringstream in(slurp(out / "probes.csv"));
-    std::string line;
-    std::getline(in, line);
-    while (std::getline(in, line)) t.push_back(std::stod(line.substr(0, line.find(','))));
-    return t;
-  };
+  auto times = [&] { return row_times(out); };
   CHECK(times() == std::vector<double>{0, 0.004, 0.008, 0.01});
   REQUIRE(run_cli("resume " + out.string() + " --quiet --end-time 0.014", &err) == 0);
   CHECK(times() == std::vector<double>{0, 0.004, 0.008, 0.012, 0.014});
@@ -481,20 +484,12 @@ TEST_CASE("checkpoint: probe rows between the frames (time.probe_interval) resum
   REQUIRE(run_cli("run " + scene.string() + " --quiet --end-time 0.006 --checkpoint-every 0.006" + rows +
                       " --out " + two.string(),
                   &err) == 0);
-  auto times = [](const fs::path& out) {
-    std::vector<double> t;
-    std::istringstream in(slurp(out / "probes.csv"));
-    std::string line;
-    std::getline(in, line);
-    while (std::getline(in, line)) t.push_back(std::stod(line.substr(0, line.find(','))));
-    return t;
-  };
-  CHECK(times(two) == std::vector<double>{0, 0.002, 0.004, 0.006});
+  CHECK(row_times(two) == std::vector<double>{0, 0.002, 0.004, 0.006});
   CHECK(outputs_of(two).frames.size() == 3);
   const int code = run_cli("resume " + two.string() + " --quiet --end-time 0.014", &err);
   INFO(err);
   REQUIRE(code == 0);
-  const std::vector<double> t = times(one);
+  const std::vector<double> t = row_times(one);
   REQUIRE(t.size() == 8);
   for (std::size_t k = 0; k < t.size(); ++k) CHECK(std::abs(t[k] - 0.002 * static_cast<double>(k)) < 1e-12);
   const Outputs a = outputs_of(one), b = outputs_of(two);
