@@ -103,7 +103,8 @@ ShellContact::Pair ShellContact::pair(const Particles& P, const Shells& sh, std:
     // along the edge, whose gap says nothing about the contact (two sheets share such a pair by their gaps,
     // above). Without this, a wall particle in the plane of a free edge (a commissure post) set a barrier
     // stiffness without bound and a step of 1e-8 s.
-    if (!(a_shell && b_shell) && !sh.over_sheet(ps, dp - sn * n, std::sqrt(0.5) * dx)) return Vec3::Zero();
+    const Vec3 foot = dp - sn * n;  // o's foot on the plane, from the patch particle
+    if (!(a_shell && b_shell) && !sh.over_sheet(ps, foot, std::sqrt(0.5) * dx)) return Vec3::Zero();
     // Near an edge a wall or elastic particle o meets the patch as a disc of radius dx / 2 (the edge
     // particle's own half spacing), not as its plane: beyond the disc's rim (foot more than dx / 2 from the
     // patch particle) the gap is the distance from the rim, and the force points from the rim to o, so a
@@ -115,7 +116,6 @@ ShellContact::Pair ShellContact::pair(const Particles& P, const Shells& sh, std:
     double ramp = 1.0;
     Vec3 e = sn >= 0.0 ? n : Vec3(-n);  // from the plane (q's or the patch's) towards o
     if (!(a_shell && b_shell) && sh.near_edge(ps)) {
-      const Vec3 foot = dp - sn * n;
       const double reach = std::sqrt(0.5) * dx, beyond = foot.norm() - 0.5 * dx;
       ramp = std::clamp((reach - 0.5 * dx - beyond) / (reach - 0.5 * dx), 0.0, 1.0);
       if (ramp <= 0.0) return Vec3::Zero();
