@@ -166,6 +166,8 @@ struct AorticRootParams {
   double stj() const { return stj_height > 0.0 ? stj_height : commissure_height; }
   double stj_radius() const { return stj_diameter > 0.0 ? 0.5 * stj_diameter : commissure_radius; }
   double aorta() const { return aorta_radius > 0.0 ? aorta_radius : stj_radius(); }
+  // Every member (sample_aortic_root shares one root between the bodies of equal parameters).
+  bool operator==(const AorticRootParams&) const = default;
 };
 
 enum class AorticPart { Wall, Blood, Leaflet };

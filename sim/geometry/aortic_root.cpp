@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <numbers>
 #include <sstream>
 #include <unordered_map>
@@ -1115,9 +1116,32 @@ std::optional<AorticRootError> check_aortic_root(const AorticRootParams& p, doub
   return e;
 }
 
+namespace {
+// One root for the bodies of a scene: the wall, the blood and the three leaflets are sampled body by body
+// with the same parameters, and the wall (its posts and embedded rows) and the blood (its gaps) each need the
+// three leaflet sheets, whose mirror surface costs a bisection per point: built once per root they were built
+// nine times, about 70 % of `aortasph check` of the physio scene (stop 62). The last few roots are kept.
+std::shared_ptr<const AorticRoot> shared_root(const AorticRootParams& p) {
+  static std::mutex m;
+  static std::deque<std::pair<AorticRootParams, std::shared_ptr<const AorticRoot>>> roots;
+  {
+    const std::lock_guard<std::mutex> lock(m);
+    for (const auto& [q, root] : roots)
+      if (q == p) return root;
+  }
+  auto root =
+      std::make_shared<const AorticRoot>(p);  // outside the lock (deterministic: built twice, the same)
+  const std::lock_guard<std::mutex> lock(m);
+  roots.emplace_back(p, root);
+  if (roots.size() > 4) roots.pop_front();
+  return root;
+}
+}  // namespace
+
 ShapeSample sample_aortic_root(const AorticRootParams& p, AorticPart part, int leaflet, double dx) {
   ShapeSample out;
-  const AorticRoot root(p);
+  const std::shared_ptr<const AorticRoot> shared = shared_root(p);
+  const AorticRoot& root = *shared;
   switch (part) {
     case AorticPart::Wall:
       out.points = root.wall_points(dx, &out.mesh);
