@@ -724,8 +724,10 @@ TEST_CASE("shell-fluid: with the barrier at work a checkpoint resumes bitwise", 
   const StateReader in(out.bytes());
   World b(s);
   b.load_state(in);
-  a.advance_to(0.006, [] { return true; });
-  b.advance_to(0.006, [] { return true; });
+  // To 2 ms (6 ms until stop 63): the lagging normals are read in the first step after the resume, so a
+  // difference shows in the state from then on.
+  a.advance_to(0.002, [] { return true; });
+  b.advance_to(0.002, [] { return true; });
   CHECK(state_hash(a) == state_hash(b));
 }
 
