@@ -1,7 +1,5 @@
 #include "renderer.hpp"
 
-#include "gl_api.hpp"  // GL and OSMesa, loaded at the first GlContext (not linked)
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -15,6 +13,7 @@
 
 #include "colormap.hpp"
 #include "embedded_shaders.hpp"
+#include "gl_api.hpp"  // GL and OSMesa, loaded at the first GlContext (not linked)
 #include "gl_context.hpp"
 
 namespace aortasph {

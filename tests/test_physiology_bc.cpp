@@ -987,7 +987,8 @@ TEST_CASE("scripts/physio_lumped.py: the shipped physio scene's boundary conditi
   // cycle, stroke volume, peak flow, aortic max, aortic min, ejection time, opening time, held time
   REQUIRE(last.size() == 8);
   INFO("cycle 3: " << last[1] << " ml, " << last[2] << " ml/s, aortic " << last[3] << " / " << last[4]
-                   << " mmHg, ejection " << last[5] << " s, opening " << last[6] << " s, held " << last[7] << " s");
+                   << " mmHg, ejection " << last[5] << " s, opening " << last[6] << " s, held " << last[7]
+                   << " s");
   CHECK(last[0] == 3);
   CHECK(last[1] > 60.0);
   CHECK(last[1] < 90.0);
