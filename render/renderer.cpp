@@ -18,19 +18,9 @@
 
 namespace aortasph {
 
-namespace {
-
-constexpr int kMaxImageSize = 16384;  // llvmpipe's renderbuffer limit
-
-glm::dvec3 to_glm(const Vec3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
-std::string vec_str(const Vec3& v) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "[%g, %g, %g]", v.x(), v.y(), v.z());
-  return buf;
-}
+// The vertex records Renderer::Impl holds (a named namespace: in a unity group, GCC reports a class member of
+// a type from an anonymous namespace, -Wsubobject-linkage).
+namespace renderer_detail {
 
 // One particle as the GPU sees it: 16 bytes.
 struct SplatVertex {
@@ -44,6 +34,25 @@ struct SheetVertex {
   float normal[3];
   uint8_t color[4];
 };
+
+}  // namespace renderer_detail
+
+using renderer_detail::SheetVertex;
+using renderer_detail::SplatVertex;
+
+namespace {
+
+constexpr int kMaxImageSize = 16384;  // llvmpipe's renderbuffer limit
+
+glm::dvec3 to_glm(const Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+std::string vec_str(const Vec3& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "[%g, %g, %g]", v.x(), v.y(), v.z());
+  return buf;
+}
 
 // Shell bodies with a sheet are drawn as that sheet, not as particles, unless hidden.
 bool drawn_as_sheet(const BodyView& body) {
