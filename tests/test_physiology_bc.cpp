@@ -890,6 +890,31 @@ TEST_CASE(
   fs::remove_all(dir);
 }
 
+TEST_CASE(
+    "open_boundary probe: with probe rows between the frames, each row's flow is the mean since the last row",
+    "[physiology][cli][heavy]") {
+  // The pulsatile tube (scenes/tube_pulse.json) to 12 ms with a probe row every 2 ms, once with a frame at
+  // every row (as shipped) and once with frames 12 ms apart (time.probe_interval): the steps land on the
+  // rows either way, so the two runs are the same and so must their probes.csv be. Until stop 63 the
+  // boundaries' flow columns were averaged from the last frame, not the last row: they differed from 4 ms
+  // on (the physio scene's 1 ms rows carried the mean since its last 10 ms frame).
+  const fs::path dir = aortasph::test::scratch("boundary_rows");
+  const std::string scene = std::string(AORTASPH_TEST_DIR) + "/../scenes/tube_pulse.json";
+  const std::string common = "run " + scene + " --quiet --no-render --threads 1 --end-time 0.012";
+  std::string err;
+  REQUIRE(aortasph::test::run_cli(common + " --out " + (dir / "frames").string(), err) == 0);
+  REQUIRE(aortasph::test::run_cli(common +
+                                      " --set time.output_interval=0.012 --set time.probe_interval=0.002" +
+                                      " --out " + (dir / "rows").string(),
+                                  err) == 0);
+  const std::string frames = aortasph::test::slurp(dir / "frames" / "probes.csv");
+  const std::string rows = aortasph::test::slurp(dir / "rows" / "probes.csv");
+  CHECK(std::count(rows.begin(), rows.end(), '\n') == 8);  // header, t = 0, 0.002, ..., 0.012
+  CHECK(frames.find("balance.lvot.flow") != std::string::npos);
+  CHECK(rows == frames);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("scenes/aortic_valve_cycle_physio.json loads: the LV waveform inlet and the systemic RCR outlet",
           "[physiology][scene]") {
   const fs::path file = fs::path(AORTASPH_TEST_DIR) / ".." / "scenes" / "aortic_valve_cycle_physio.json";

@@ -93,7 +93,11 @@ void OpenBoundaries::configure(const Scene& scene, const std::vector<FluidParams
   fluid_ = fluid;
   dx_ = scene.spacing;
   support_ = 2.0 * scene.smoothing_ratio * scene.spacing;
-  output_interval_ = scene.output_interval;
+  // Probe rows come every time.probe_interval (a whole fraction of output_interval; a scene built in code may
+  // leave probe_interval at its default and set only output_interval, hence the smaller of the two). Until
+  // stop 63 the interval was output_interval: with rows between the frames (the physio scene's 1 ms rows, 10
+  // ms frames) a row's boundary flow was the mean since the last frame.
+  row_interval_ = std::min(scene.output_interval, scene.probe_interval);
   const double dx = dx_;
   zones_.clear();
   for (std::size_t k = 0; k < scene.open_boundaries.size(); ++k) {
@@ -578,13 +582,13 @@ OpenBoundaryChange OpenBoundaries::update(Particles& P, const NeighborSearch& nb
   if (zones_.empty()) return {};
   const std::size_t n = P.size();
 
-  // A step that starts at an output time (a multiple of time.output_interval) starts a new averaging interval
-  // of the boundaries' flows.
-  if (output_interval_ > 0.0) {
+  // A step that starts at a probe row's time (a multiple of time.probe_interval) starts a new averaging
+  // interval of the boundaries' flows.
+  if (row_interval_ > 0.0) {
     const double t_old = t_new - dt;
-    const double k = std::round(t_old / output_interval_);
-    if (std::abs(t_old - k * output_interval_) <= 1e-6 * dt && k * output_interval_ > interval_start_) {
-      interval_start_ = k * output_interval_;
+    const double k = std::round(t_old / row_interval_);
+    if (std::abs(t_old - k * row_interval_) <= 1e-6 * dt && k * row_interval_ > interval_start_) {
+      interval_start_ = k * row_interval_;
       for (OpenBoundaryFlow& f : flows_) f.interval_volume = 0.0;
     }
   }

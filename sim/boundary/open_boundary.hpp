@@ -252,7 +252,7 @@ class OpenBoundaries {
   std::vector<FluidParams> fluid_;
   double dx_ = 0.0;
   double support_ = 0.0;
-  double output_interval_ = 0.0;
+  double row_interval_ = 0.0;  // the probe rows' interval: each row's flow is the mean since the last row
   double list_reach_ = std::numeric_limits<double>::infinity();
   OpenBoundaryState state_;
   std::vector<OpenBoundaryFlow> flows_;
