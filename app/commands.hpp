@@ -7,6 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "io/checkpoint.hpp"
+#include "scene_loader.hpp"
+
 namespace aortasph {
 
 struct RunOptions {
@@ -35,8 +38,17 @@ int cmd_resume(const ResumeOptions& options);
 // resume: the scene as this program resolves it (now), less the keys the recorded resolution lacks (keys
 // added since, at defaults that keep the older behaviour), for comparing with what the checkpoint recorded.
 nlohmann::json pruned_to(const nlohmann::json& now, const nlohmann::json& recorded);
+// A run folder's checkpoint (DIR/checkpoint.bin, as `resume` reads it): the scene it was written with,
+// resolved again and refused where it no longer resolves to the recorded values, then `sets` (--set
+// KEY=VALUE) applied on top; and its state, for World::load_state. Throws InputError naming a missing or
+// damaged file.
+struct CheckpointScene {
+  LoadedScene loaded;
+  StateReader state;
+};
+CheckpointScene load_checkpoint(const std::filesystem::path& dir, const std::vector<std::string>& sets);
 int cmd_check(const std::filesystem::path& scene, const std::vector<std::string>& sets);
-// aortasph bench [--threads N] [--quick] [--render] [--json FILE] [--case NAME | --scene FILE]
+// aortasph bench [--threads N] [--quick] [--render] [--json FILE] [--case NAME | --scene FILE | --from DIR]
 //                [--set KEY=VALUE]... [--steps N]
 struct BenchOptions {
   int threads = 0;
@@ -45,7 +57,8 @@ struct BenchOptions {
   std::filesystem::path json = "bench.json";
   std::string case_name = "dam_break";         // standard cases: dam_break, aortic_root
   std::optional<std::filesystem::path> scene;  // --scene FILE: any scene instead of a standard case
-  std::vector<std::string> sets;               // --set KEY=VALUE on --scene or --case aortic_root
+  std::optional<std::filesystem::path> from;   // --from DIR: a run folder's checkpoint (mid-run state)
+  std::vector<std::string> sets;               // --set KEY=VALUE on --scene, --from or --case aortic_root
   int steps = 0;                               // 0: 60 (40 with --quick)
 };
 

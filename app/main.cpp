@@ -32,7 +32,9 @@ const char* kUsage =
     "  aortasph study STUDY.json [--out DIR] [-j N] [--dry-run] [--cluster-hint]\n"
     "                                                   a parameter sweep on Snakemake (docs/studies.md)\n"
     "  aortasph bench [--threads N] [--quick] [--render] [--json FILE] [--steps N]\n"
-    "                [--case dam_break|aortic_root | --scene SCENE.json] [--set KEY=VALUE]...\n"
+    "                [--case dam_break|aortic_root | --scene SCENE.json | --from RUN_DIR] [--set "
+    "KEY=VALUE]...\n"
+    "                                                   --from: from a run folder's checkpoint.bin\n"
     "  aortasph --help | --version\n"
     "\n"
     "exit codes: 0 ok, 1 compare: images differ, 2 bad input, 3 unstable simulation, 130 interrupted\n"
@@ -104,6 +106,8 @@ int dispatch(const std::vector<std::string>& args) {
         case_given = true;
       } else if (rest[k] == "--scene" && has_value) {
         o.scene = rest[++k];
+      } else if (rest[k] == "--from" && has_value) {
+        o.from = rest[++k];
       } else if (rest[k] == "--set" && has_value) {
         o.sets.push_back(rest[++k]);
       } else {
@@ -111,6 +115,8 @@ int dispatch(const std::vector<std::string>& args) {
       }
     }
     if (o.scene && case_given) throw InputError("bench: --scene and --case exclude each other");
+    if (o.from && (o.scene || case_given || o.quick))
+      throw InputError("bench: --from excludes --scene, --case and --quick");
     return cmd_bench(o);
   }
   if (cmd == "compare") return cmd_compare(rest);

@@ -61,8 +61,8 @@ double estimate_particles(const Scene& scene) {
 }
 
 double bytes_per_particle(const Scene& scene) {
-  // Neighbours within 1.1 supports (support = 2 h = 2 smoothing_ratio dx) on the cubic lattice.
-  const double radius = 1.1 * 2.0 * scene.smoothing_ratio;
+  // Neighbours within 1 + skin supports (support = 2 h = 2 smoothing_ratio dx) on the cubic lattice.
+  const double radius = (1.0 + scene.skin) * 2.0 * scene.smoothing_ratio;
   const double neighbours = 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
   return 160.0 + 4.0 * neighbours * 1.5 + 100.0;
 }

@@ -712,8 +712,18 @@ ResumeOptions parse_resume_options(const std::vector<std::string>& args) {
   return o;
 }
 
-int cmd_resume(const ResumeOptions& ro) {
-  const std::filesystem::path file = ro.dir / kCheckpointFile;
+namespace {
+
+// A run folder's checkpoint opened as `resume` opens it: the state, its run record and the recorded scene
+// resolved again by this program (refused where it no longer resolves to the recorded values).
+struct OpenedCheckpoint {
+  StateReader state;
+  RunRecord record;
+  LoadedScene loaded;
+};
+
+OpenedCheckpoint open_checkpoint(const std::filesystem::path& dir) {
+  const std::filesystem::path file = dir / kCheckpointFile;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec))
     throw InputError(file.string() +
@@ -726,15 +736,15 @@ int cmd_resume(const ResumeOptions& ro) {
       throw InputError(e.what());
     }
   }();
-  const RunRecord record = RunRecord::load(state, file);
+  RunRecord record = RunRecord::load(state, file);
   nlohmann::json resolved = nlohmann::json::parse(record.scene, nullptr, false);
   if (resolved.is_discarded()) throw InputError(file.string() + ": the recorded scene is not valid JSON");
   // run.json names the scene this folder's files belong to: a checkpoint of another scene is refused.
-  std::ifstream run_json(ro.dir / "run.json");
+  std::ifstream run_json(dir / "run.json");
   if (run_json) {
     const nlohmann::json j = nlohmann::json::parse(run_json, nullptr, false);
     if (j.is_discarded() || !j.contains("scene") || scene_hash(j["scene"]) != record.hash)
-      throw InputError((ro.dir / "run.json").string() + " describes another scene than " + file.string() +
+      throw InputError((dir / "run.json").string() + " describes another scene than " + file.string() +
                        " (scene hash mismatch); refusing to mix two runs in one folder");
   }
   // Loaded as the file was (figure times are checked against the file's time.end), then --end-time again.
@@ -752,6 +762,31 @@ int cmd_resume(const ResumeOptions& ro) {
       scene_hash(pruned_to(loaded.resolved, resolved)) != record.hash)
     throw InputError(file.string() + ": the recorded scene no longer resolves to the same values with this " +
                      "program; cannot resume");
+  return {std::move(state), std::move(record), std::move(loaded)};
+}
+
+}  // namespace
+
+CheckpointScene load_checkpoint(const std::filesystem::path& dir, const std::vector<std::string>& sets) {
+  OpenedCheckpoint c = open_checkpoint(dir);
+  if (sets.empty()) return {std::move(c.loaded), std::move(c.state)};
+  // The overrides on top of the recorded scene (its resolved JSON holds every key with its value).
+  nlohmann::json as_file = c.loaded.resolved;
+  if (c.record.end_override > 0.0) as_file["time"]["end"] = c.record.file_end;
+  LoadedScene loaded =
+      load_scene_json(as_file, sets, std::filesystem::path(c.record.scene_file).parent_path());
+  if (c.record.end_override > 0.0) {
+    loaded.scene.t_end = c.record.end_override;
+    loaded.resolved["time"]["end"] = c.record.end_override;
+  }
+  return {std::move(loaded), std::move(c.state)};
+}
+
+int cmd_resume(const ResumeOptions& ro) {
+  OpenedCheckpoint c = open_checkpoint(ro.dir);
+  StateReader& state = c.state;
+  const RunRecord& record = c.record;
+  LoadedScene& loaded = c.loaded;
   RunOptions o;
   o.scene = record.scene_file;
   o.out = ro.dir;

@@ -201,11 +201,14 @@ class Loader {
     s.max_leave_fraction = dom.non_negative("max_leave_fraction", 0.0);
     if (s.max_leave_fraction > 1) fail(dom.path("max_leave_fraction"), "must lie in 0..1");
 
-    Obj res(top.raw("resolution"), "resolution", {"spacing", "smoothing_ratio"}, allowed);
+    Obj res(top.raw("resolution"), "resolution", {"spacing", "smoothing_ratio", "skin"}, allowed);
     s.spacing = res.positive("spacing");
     s.smoothing_ratio = res.number("smoothing_ratio", 1.3);
     if (s.smoothing_ratio < 1.0 || s.smoothing_ratio > 3.0)
       fail(res.path("smoothing_ratio"), "must lie in 1..3");
+    s.skin = res.number("skin", 0.1);
+    if (s.skin < 0.02 || s.skin > 0.5)
+      fail(res.path("skin"), "must lie in 0.02..0.5 (of the kernel support)");
 
     Obj time(top.raw("time"), "time",
              {"end", "output_interval", "probe_interval", "cfl", "max_dt", "max_speed", "max_density_error",
@@ -323,7 +326,8 @@ class Loader {
     }
     if (!s.open_boundaries.empty())
       fail("open_boundaries", "open boundaries are not supported in a periodic domain (domain.periodic)");
-    const double radius = 1.1 * 2.0 * s.smoothing_ratio * s.spacing;  // kernel support plus the lists' skin
+    const double radius =
+        (1.0 + s.skin) * 2.0 * s.smoothing_ratio * s.spacing;  // support plus the lists' skin
     for (int a = 0; a < 3; ++a) {
       const double len = s.domain.max[a] - s.domain.min[a];
       if (s.periodic[a] && len < 2.5 * radius * (1.0 + 1e-9)) {

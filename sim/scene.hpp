@@ -429,6 +429,9 @@ struct Scene {
   bool pressure_gauge_open = true;
   double spacing = 0.01;
   double smoothing_ratio = 1.3;  // h = smoothing_ratio * spacing
+  // The Verlet lists' skin as a fraction of the kernel support: lists hold pairs within support (1 + skin)
+  // and are rebuilt when a particle has moved skin / 2 (World::update_neighbors).
+  double skin = 0.1;
   double t_end = 1.0;
   double output_interval = 0.01;
   // Rows of probes.csv and diagnostics.csv at k * probe_interval; output_interval is a whole multiple of it

@@ -301,7 +301,7 @@ World::World(const Scene& scene)
   contact_in_substeps_ = shell_contact_.active() && solids_.empty() && max_c0_ > 0.0;
 
   // Spatial sort once, so neighbours sit close in memory from the first step.
-  skin_ = 0.1 * kernel_.support;
+  skin_ = scene.skin * kernel_.support;
   open_.set_list_reach(kernel_.support + skin_);
   nb_.bin(P_.x, kernel_.support);  // the cells alone: spatial_order() needs no lists
   permute(nb_.spatial_order());

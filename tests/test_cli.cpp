@@ -207,11 +207,36 @@ TEST_CASE("cli: bench --scene steps any scene and reports particle-steps, phases
                          {"bench --scene " + (dir / "missing.json").string(), "missing.json"},
                          {"bench --steps 0", "--steps"},
                          {"bench --scene " + scene.string() + " --case aortic_root", "--case"},
-                         {"bench --set resolution.spacing=0.004", "--set"}}) {
+                         {"bench --set resolution.spacing=0.004", "--set"},
+                         {"bench --from " + (dir / "norun").string(), "checkpoint.bin"},
+                         {"bench --from " + dir.string() + " --scene " + scene.string(), "--from"}}) {
     const Result b = aortasph(c.args + " --json " + (dir / "x.json").string());
     INFO(c.args << ": exit " << b.code << ", stderr: " << b.err);
     CHECK(b.code == 2);
     CHECK(b.err.find(c.expect) != std::string::npos);
+  }
+
+  // --from: the state of a run folder's checkpoint, here the tiny run's at its end (t = 2 ms), stepped on
+  // with the recorded scene and a --set on top (a skin of 30 % lists more neighbours than the default 10 %).
+  const Result run = aortasph("run " + scene.string() + " --out " + (dir / "run").string() +
+                              " --quiet --no-render --checkpoint-every 0.001");
+  REQUIRE(run.code == 0);
+  const auto number = [](const std::string& text, const std::string& name) {
+    const std::string key = "\"" + name + "\": ";
+    const auto at = text.find(key);
+    return at == std::string::npos ? -1.0 : std::stod(text.substr(at + key.size()));
+  };
+  for (const double skin : {0.1, 0.3}) {
+    const Result from = aortasph("bench --from " + (dir / "run").string() + " --steps 2 --threads 1 --json " +
+                                 json.string() + " --set resolution.skin=" + std::to_string(skin));
+    INFO(from.err);
+    REQUIRE(from.code == 0);
+    const std::string b = slurp(json);
+    CHECK(number(b, "from_time_s") == Approx(0.002));
+    CHECK(number(b, "skin") == Approx(skin));
+    CHECK(number(b, "fluid_particles") == 150.0);
+    if (skin == 0.1) CHECK(number(b, "neighbours_per_particle") > 1.0);
+    if (skin == 0.3) CHECK(number(b, "neighbours_per_particle") > 1.2 * number(j, "neighbours_per_particle"));
   }
 }
 

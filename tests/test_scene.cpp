@@ -42,6 +42,7 @@ TEST_CASE("a valid scene loads with its values and defaults", "[scene]") {
   CHECK(s.name == "t");
   CHECK(s.spacing == 0.01);
   CHECK(s.smoothing_ratio == 1.3);  // default
+  CHECK(s.skin == 0.1);             // default
   CHECK(s.gravity == Vec3(0, -9.81, 0));
   REQUIRE(s.materials.size() == 3);
   CHECK(s.materials[s.bodies[1].material].name == "wall");
@@ -51,6 +52,7 @@ TEST_CASE("a valid scene loads with its values and defaults", "[scene]") {
   CHECK(s.probes[0].bodies == std::vector<int>{0});
   // Defaults are written into the resolved JSON (run.json).
   CHECK(l.resolved["resolution"]["smoothing_ratio"] == 1.3);
+  CHECK(l.resolved["resolution"]["skin"] == 0.1);
   CHECK(l.resolved["materials"]["water"]["eos_exponent"] == 7.0);
 }
 
