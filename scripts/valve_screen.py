@@ -8,8 +8,8 @@ damped) with some `aortic_root` keys changed, run twice with `aortasph run`:
 Under a minute per variant on one thread. docs/validation.md, "Stop 63", has the table this printed.
 
 A variant is NAME or NAME:KEY=VALUE,KEY=VALUE,... where KEY is an aortic_root key (lunula_height,
-lunula_radius, mirror_tilt, ...) or `lunula_thickness` [m]: the lunula gets its own shell material, the
-leaflet's with that thickness. Without variants the stop-63 set is run.
+lunula_radius, mirror_tilt, ...), `lunula_thickness` [m]: the lunula gets its own shell material, the
+leaflet's with that thickness, or `hourglass`: every sheet's hourglass control (the shell key, default 0.05). Without variants the stop-63 set is run.
 
 Usage: scripts/valve_screen.py [--bin build/aortasph] [--out out/valve_screen] [-j 2] [VARIANT ...]
 """
@@ -64,11 +64,15 @@ def scene_of(base, keys, mode):
     s = copy.deepcopy(base)
     keys = dict(keys)
     thickness = keys.pop("lunula_thickness", None)
+    hourglass = keys.pop("hourglass", None)
     s["aortic_root"].update(keys)
     if thickness is not None:
         lunula = dict(s["materials"]["leaf"], thickness=thickness)
         s["materials"]["lunula"] = lunula
         s["aortic_root"]["lunula_material"] = "lunula"
+    if hourglass is not None:
+        for m in s["materials"].values():
+            m["hourglass"] = hourglass
     for b in s["bodies"]:
         b["pressure_load"] = [[0, 0], [0.006, -10700]] if mode == "closed" else 1000
     if mode == "open":
