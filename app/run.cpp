@@ -727,7 +727,7 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& dir) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec))
     throw InputError(file.string() +
-                     ": no checkpoint to resume from (run with --checkpoint-every T, or stop " +
+                     ": no checkpoint here (write one with run --checkpoint-every T, or stop " +
                      "a run with Ctrl-C / SIGTERM)");
   StateReader state = [&] {
     try {
