@@ -722,7 +722,9 @@ struct OpenedCheckpoint {
   LoadedScene loaded;
 };
 
-OpenedCheckpoint open_checkpoint(const std::filesystem::path& dir) {
+// sets: --set overrides applied after the check (bench --from), on the scene as it was recorded.
+OpenedCheckpoint open_checkpoint(const std::filesystem::path& dir,
+                                 const std::vector<std::string>& sets = {}) {
   const std::filesystem::path file = dir / kCheckpointFile;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec))
@@ -751,35 +753,31 @@ OpenedCheckpoint open_checkpoint(const std::filesystem::path& dir) {
   nlohmann::json as_file = resolved;
   if (record.end_override > 0.0) as_file["time"]["end"] = record.file_end;
   // Files the scene names (waveforms) are relative to the scene file's folder, as when it was run.
-  LoadedScene loaded = load_scene_json(as_file, {}, std::filesystem::path(record.scene_file).parent_path());
-  if (record.end_override > 0.0) {
-    loaded.scene.t_end = record.end_override;
-    loaded.resolved["time"]["end"] = record.end_override;
-  }
+  const std::filesystem::path base = std::filesystem::path(record.scene_file).parent_path();
+  const auto load = [&](const std::vector<std::string>& overrides) {
+    LoadedScene l = load_scene_json(as_file, overrides, base);
+    if (record.end_override > 0.0) {
+      l.scene.t_end = record.end_override;
+      l.resolved["time"]["end"] = record.end_override;
+    }
+    return l;
+  };
+  LoadedScene loaded = load({});
   // The same values as when it ran; keys this program added since are left out of the comparison
   // (pruned_to): a run of an older program resumes with them at their defaults.
   if (scene_hash(loaded.resolved) != record.hash &&
       scene_hash(pruned_to(loaded.resolved, resolved)) != record.hash)
     throw InputError(file.string() + ": the recorded scene no longer resolves to the same values with this " +
                      "program; cannot resume");
+  if (!sets.empty()) loaded = load(sets);
   return {std::move(state), std::move(record), std::move(loaded)};
 }
 
 }  // namespace
 
 CheckpointScene load_checkpoint(const std::filesystem::path& dir, const std::vector<std::string>& sets) {
-  OpenedCheckpoint c = open_checkpoint(dir);
-  if (sets.empty()) return {std::move(c.loaded), std::move(c.state)};
-  // The overrides on top of the recorded scene (its resolved JSON holds every key with its value).
-  nlohmann::json as_file = c.loaded.resolved;
-  if (c.record.end_override > 0.0) as_file["time"]["end"] = c.record.file_end;
-  LoadedScene loaded =
-      load_scene_json(as_file, sets, std::filesystem::path(c.record.scene_file).parent_path());
-  if (c.record.end_override > 0.0) {
-    loaded.scene.t_end = c.record.end_override;
-    loaded.resolved["time"]["end"] = c.record.end_override;
-  }
-  return {std::move(loaded), std::move(c.state)};
+  OpenedCheckpoint c = open_checkpoint(dir, sets);
+  return {std::move(c.loaded), std::move(c.state)};
 }
 
 int cmd_resume(const ResumeOptions& ro) {

@@ -9,7 +9,8 @@ Under a minute per variant on one thread. docs/validation.md, "Stop 63", has the
 
 A variant is NAME or NAME:KEY=VALUE,KEY=VALUE,... where KEY is an aortic_root key (lunula_height,
 lunula_radius, mirror_tilt, ...), `lunula_thickness` [m]: the lunula gets its own shell material, the
-leaflet's with that thickness, or `hourglass`: every sheet's hourglass control (the shell key, default 0.05). Without variants the stop-63 set is run.
+leaflet's with that thickness, or `hourglass`: every sheet's hourglass control (the shell key, default
+0.05). Without variants the stop-63 set is run.
 
 Usage: scripts/valve_screen.py [--bin build/aortasph] [--out out/valve_screen] [-j 2] [VARIANT ...]
 """
