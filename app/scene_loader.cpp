@@ -476,6 +476,7 @@ class Loader {
                 "thickness",
                 "model",
                 "damping",
+                "dynamic_viscosity",
                 "hourglass",
                 "c1",
                 "c2",
@@ -631,6 +632,7 @@ class Loader {
                                     " spacings: a shell may be at most " + json(kMaxShellThickness).dump() +
                                     " spacings thick (resolve a thicker sheet with an elastic body)");
     m.shell_damping = o.non_negative("damping", 0.0);
+    m.shell_viscosity = o.non_negative("dynamic_viscosity", 0.0);
     m.hourglass = o.non_negative("hourglass", 0.05);
   }
 

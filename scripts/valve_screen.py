@@ -9,8 +9,9 @@ Under a minute per variant on one thread. docs/validation.md, "Stop 63", has the
 
 A variant is NAME or NAME:KEY=VALUE,KEY=VALUE,... where KEY is an aortic_root key (lunula_height,
 lunula_radius, mirror_tilt, ...), `lunula_thickness` [m]: the lunula gets its own shell material, the
-leaflet's with that thickness, or `hourglass`: every sheet's hourglass control (the shell key, default
-0.05). Without variants the stop-63 set is run.
+leaflet's with that thickness, `hourglass`: every sheet's hourglass control (the shell key, default
+0.05), or `dynamic_viscosity`: every sheet's Kelvin-Voigt viscosity [Pa s] (the shell key, default 0).
+Without variants the stop-63 set is run.
 
 Usage: scripts/valve_screen.py [--bin build/aortasph] [--out out/valve_screen] [-j 2] [VARIANT ...]
 """
@@ -66,6 +67,7 @@ def scene_of(base, keys, mode):
     keys = dict(keys)
     thickness = keys.pop("lunula_thickness", None)
     hourglass = keys.pop("hourglass", None)
+    viscosity = keys.pop("dynamic_viscosity", None)
     s["aortic_root"].update(keys)
     if thickness is not None:
         lunula = dict(s["materials"]["leaf"], thickness=thickness)
@@ -74,6 +76,10 @@ def scene_of(base, keys, mode):
     if hourglass is not None:
         for m in s["materials"].values():
             m["hourglass"] = hourglass
+    if viscosity is not None:
+        for m in s["materials"].values():
+            if m.get("type") == "shell":
+                m["dynamic_viscosity"] = viscosity
     for b in s["bodies"]:
         b["pressure_load"] = [[0, 0], [0.006, -10700]] if mode == "closed" else 1000
     if mode == "open":

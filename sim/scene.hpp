@@ -71,8 +71,9 @@ struct Material {
 
   // Shell (one layer on the mid-surface, sim/solid/shell.hpp): density, youngs_modulus, poisson_ratio and
   // neo_hookean as above (plane stress), hourglass its own default (see the loader).
-  double thickness = 0.0;      // [m]
-  double shell_damping = 0.0;  // mass-proportional damping of velocity and spin [1/s]
+  double thickness = 0.0;        // [m]
+  double shell_damping = 0.0;    // mass-proportional damping of velocity and spin [1/s]
+  double shell_viscosity = 0.0;  // Kelvin-Voigt dynamic viscosity of the in-plane strain rate [Pa s]
   // model "lee_sacks" (incompressible, as neo_hookean, which it extends): the exponential terms
   // c1/2 (delta (exp(c2 (I1 - 3)^2) - 1) + (1 - delta) (exp(c3 (I4 - 1)^2) - 1)) of the Lee-Sacks form
   // (sim/solid/shell_material.hpp), I4 the squared stretch along the fibre direction; c1 = 0: none.

@@ -726,7 +726,7 @@ void World::step_shells(double dt) {
 // their position (and, fixed, their director).
 void World::shell_substep(double h, double kick, double t, const std::vector<Vec3>& held,
                           const std::vector<Vec3>* barrier) {
-  shells_.update(P_);
+  shells_.update(P_, &sub_.v);  // sub_.v, half a sub-step behind: the viscous shells' strain rate
   // Shell contact at the sheets' positions, directors and velocities of this sub-step (contact_in_substeps_).
   if (contact_in_substeps_) {
     contact_f_.resize(P_.size());

@@ -188,6 +188,58 @@ TEST_CASE("shell patch test: a rigid 90 degree rotation about any axis gives zer
   }
 }
 
+TEST_CASE("shell viscosity: a rigid spin feels no Kelvin-Voigt force, a stretch rate the elastic law's shape",
+          "[shell]") {
+  const double dx = 0.01, E = 1e6, t = 0.004, eta = 50.0;
+  std::vector<Material> mats = {shell_material(E, 0.0, t)};
+  mats[0].shell_viscosity = eta;
+  const CubicSpline kernel(1.3 * dx);
+  // A sheet turned by R and spinning rigidly at Omega (positions, velocities and director spin): E' = 0.
+  const Vec3 Omega = Vec3(3, -2, 5);
+  const Mat3 R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  Sheet U = sheet(8, 8, dx);
+  for (std::size_t i = 0; i < U.P.size(); ++i) U.P.x[i] = R * U.P.x0[i] + Vec3(0.3, -0.2, 0.1);
+  Shells rr(U.P, mats, kernel, U.seed);
+  std::vector<Vec3> v(rr.size());
+  for (std::size_t s = 0; s < rr.size(); ++s) {
+    rr.set_director(s, R * Vec3::UnitZ());
+    rr.omegas()[s] = Omega;
+    v[s] = Omega.cross(U.P.x[rr.at(s)]) + Vec3(1, 2, 3);
+  }
+  rr.update(U.P, &v);
+  const double f0 = 2.0 * eta * Omega.norm() * t * dx;  // the force scale of a strain rate |Omega|
+  double fmax = 0.0;
+  for (std::size_t s = 0; s < rr.size(); ++s) {
+    CHECK(rr.internal_force(s).norm() < 1e-9 * f0);
+    CHECK(rr.torque(s).norm() < 1e-9 * f0 * t);
+  }
+  // The same sheet stretching along x at the rate r (v = (r x, 0, 0)): S_v = 2 eta r on the 11 component.
+  // With nu = 0 the elastic law is S = E E, so every particle's viscous force is the force of the sheet
+  // stretched by e (S11 = E (e + e^2 / 2), P11 = (1 + e) S11) scaled by 2 eta r / ((1 + e) E (e + e^2 / 2)).
+  Sheet S = sheet(9, 7, dx);
+  const double r = 20.0, e = 1e-3;
+  Shells visc(S.P, mats, kernel, S.seed);
+  std::vector<Vec3> vs(visc.size());
+  for (std::size_t s = 0; s < visc.size(); ++s) vs[s] = Vec3(r * S.P.x0[visc.at(s)].x(), 0, 0);
+  visc.update(S.P, &vs);
+  Sheet T = sheet(9, 7, dx);
+  for (std::size_t i = 0; i < T.P.size(); ++i) T.P.x[i] = Vec3((1 + e) * T.P.x0[i].x(), T.P.x0[i].y(), 0);
+  Shells el(T.P, {shell_material(E, 0.0, t)}, kernel, T.seed);
+  el.update(T.P);
+  const double scale = 2.0 * eta * r / ((1 + e) * E * (e + 0.5 * e * e));
+  for (std::size_t s = 0; s < visc.size(); ++s) {
+    INFO("particle " << s);
+    fmax = std::max(fmax, visc.internal_force(s).norm());
+    CHECK((visc.internal_force(s) - scale * el.internal_force(s)).norm() <
+          1e-6 * scale * el.internal_force(s).norm() + 1e-12);
+  }
+  CHECK(fmax > 0.1 * 2.0 * eta * r * t * dx);  // the edges carry it: not zero
+  // Without the velocities (update(P)) the viscous sheet is the elastic one: no force at rest.
+  visc.update(S.P);
+  for (std::size_t s = 0; s < visc.size(); ++s)
+    CHECK(visc.internal_force(s).norm() < 1e-9 * 2.0 * eta * r * t * dx);
+}
+
 TEST_CASE("shell patch test: a constant-curvature bend gives M = D kappa", "[shell]") {
   // A strip bent onto a cylinder of radius Rb about the y axis, length preserved, directors the cylinder's
   // normals: kappa = 1 / Rb, M11 = D kappa, M22 = nu D kappa, no membrane force.
@@ -515,6 +567,56 @@ TEST_CASE("shell validation: a cantilever strip's energy over ten periods", "[.s
   cantilever_frequency_and_energy(10.0);
 }
 
+// A clamped bar's first axial mode with and without the Kelvin-Voigt viscosity (`dynamic_viscosity`): with
+// nu = 0 the in-plane viscous stress 2 eta E' is the elastic E E times 2 eta / E, a stiffness-proportional
+// (Rayleigh) damping, so each in-plane mode decays at zeta = eta omega / E with its own omega.
+static std::pair<double, double> bar_axial_mode(double eta, double periods) {
+  const double L = 0.2, dx = L / 20, E = 1e7, rho = 1000.0;
+  Scene sc = strip_scene(L, 3 * dx, dx, dx, E, rho);
+  sc.materials[0].shell_viscosity = eta;
+  sc.domain = {Vec3(-0.25 * L, -0.25 * L, -0.25 * L), Vec3(1.25 * L, 0.25 * L, 0.25 * L)};  // a small grid
+  World w(sc);
+  const double c = std::sqrt(E / rho), T = 4 * L / c, v0 = 1e-4 * c;
+  w.set_initial_velocity(0, [&](const Vec3& x0) {
+    return Vec3(x0.x() > 0 ? v0 * std::sin(std::numbers::pi * x0.x() / (2 * L)) : 0, 0, 0);
+  });
+  const std::size_t tip = nearest(w, Vec3(L, 0, 0));
+  std::vector<double> u;
+  const int per = 200;
+  for (int k = 1; k <= per * periods; ++k) {
+    w.advance_to(k * T / per, [] { return true; });
+    u.push_back(w.particles().x[tip].x() - w.particles().x0[tip].x());
+  }
+  // Extrema of u (parabola through the three samples about each) and the zero crossings.
+  std::vector<double> amp, tz;
+  for (std::size_t k = 1; k + 1 < u.size(); ++k) {
+    if ((u[k] > u[k - 1] && u[k] >= u[k + 1]) || (u[k] < u[k - 1] && u[k] <= u[k + 1])) {
+      const double a = 0.5 * (u[k - 1] + u[k + 1]) - u[k], b = 0.5 * (u[k + 1] - u[k - 1]);
+      amp.push_back(std::abs(u[k] - b * b / (4 * a)));
+    }
+    if ((u[k - 1] < 0) != (u[k] < 0)) tz.push_back((k - 1 + u[k - 1] / (u[k - 1] - u[k])) * T / per);
+  }
+  REQUIRE(amp.size() >= 4);
+  REQUIRE(tz.size() >= 3);
+  const double omega = std::numbers::pi * static_cast<double>(tz.size() - 1) / (tz.back() - tz.front());
+  const double delta = std::log(amp.front() / amp.back()) / static_cast<double>(amp.size() - 1);  // per half
+  const double zeta = delta / std::sqrt(std::numbers::pi * std::numbers::pi + delta * delta);
+  return {omega, zeta};
+}
+
+TEST_CASE("shell viscosity: a bar's axial mode decays at zeta = eta omega / E", "[shell]") {
+  const double E = 1e7, L = 0.2, omega0 = std::numbers::pi / 2 * std::sqrt(E / 1000.0) / L;
+  const auto [w_el, z_el] = bar_axial_mode(0.0, 3.0);
+  const double eta = 0.05 * E / omega0;
+  const auto [w_v, z_v] = bar_axial_mode(eta, 3.0);
+  WARN("bar axial mode: omega " << w_el << " rad/s (continuum " << omega0 << "), zeta " << z_el
+                                << "; with eta = " << eta << " Pa s: omega " << w_v << ", zeta " << z_v
+                                << " against eta omega / E = " << eta * w_el / E);
+  CHECK(w_el == Approx(omega0).epsilon(0.1));  // 5 % low: the clamp's first-order error, as the cantilever's
+  CHECK(std::abs(z_el) < 0.002);
+  CHECK(z_v == Approx(eta * w_el / E).epsilon(0.05));
+}
+
 TEST_CASE("shell: a strip periodic across its width bends cylindrically, as the plane-strain plate",
           "[shell][periodic][heavy]") {
   // The plate of O'Connor & Rogers 2021 (scenes/shell_hydrostatic_fsi.json) without its water: L = 1 m
@@ -629,6 +731,9 @@ TEST_CASE("shell: bad input exits 2 naming the key", "[shell][bad-input]") {
        "materials.sheet.model: unknown value 'ogden'"},
       {"negative damping", replaced(good, "\"thickness\": 0.01", "\"thickness\": 0.01, \"damping\": -1"),
        "materials.sheet.damping: must not be negative"},
+      {"negative dynamic_viscosity",
+       replaced(good, "\"thickness\": 0.01", "\"thickness\": 0.01, \"dynamic_viscosity\": -3"),
+       "materials.sheet.dynamic_viscosity: must not be negative"},
       {"rectangle samples nothing", replaced(good, "\"size\": [0.4, 0.1]", "\"size\": [0.4, 0.005]"),
        "bodies[0].shape.rectangle.size[1]: samples no particle"},
       {"disc samples nothing",

@@ -73,6 +73,7 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
   for (std::size_t m = 0; m < materials.size(); ++m)
     if (materials[m].type == MaterialType::Shell) params_[m] = ShellParams(materials[m]);
   for (const ShellParams& p : params_) stiffens_ = stiffens_ || p.c1 > 0.0;
+  for (const ShellParams& p : params_) viscous_ = viscous_ || p.eta > 0.0;
   uint32_t max_id = 0;
   for (std::size_t i = 0; i < P.size(); ++i) max_id = std::max(max_id, P.id[i]);
   s_of_id_.assign(P.size() == 0 ? 0 : max_id + 1, kNone);
@@ -218,6 +219,10 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
   });
 
   x_.resize(n);
+  if (viscous_) {
+    Gd_.assign(n, Mat32::Zero());
+    Hd_.assign(n, Mat32::Zero());
+  }
   G_.assign(n, Mat32::Zero());
   normal_.assign(n, Vec3::Zero());
   has_normal_.assign(n, 0);
@@ -249,9 +254,11 @@ void Shells::reindex(const Particles& P) {
   map_slots(P, Kind::Shell, s_of_id_, id_, X_, "shell", at_, slot_);
 }
 
-void Shells::update(const Particles& P) {
+void Shells::update(const Particles& P, const std::vector<Vec3>* v) {
   parallel_for(X_.size(), [&](std::size_t s) { x_[s] = P.x[at_[s]]; });
+  v_ = viscous_ && v && v->size() == X_.size() ? v : nullptr;
   compute();
+  v_ = nullptr;
 }
 
 void Shells::restore_update(std::vector<Vec3> x, std::vector<Vec3> d) {
@@ -275,6 +282,18 @@ void Shells::compute() {
     if (offset_[s] == offset_[s + 1]) G << T1_[s], T2_[s];
     G_[s] = G;
     H_[s] = H;
+    if (v_) {  // their rates (the Kelvin-Voigt stress): G' from the velocities, H' from d' = omega x d
+      const std::vector<Vec3>& v = *v_;
+      Mat32 Gd = Mat32::Zero(), Hd = Mat32::Zero();
+      const Vec3 dds = omega_[s].cross(d_[s]);
+      for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
+        const uint32_t t = nbr_[k];
+        Gd += area_[t] * (v[t] - v[s]) * g_[k].transpose();
+        Hd += area_[t] * (omega_[t].cross(d_[t]) - dds) * g_[k].transpose();
+      }
+      Gd_[s] = Gd;
+      Hd_[s] = Hd;
+    }
     const Vec3 nrm = G.col(0).cross(G.col(1));
     const double len = nrm.norm();
     has_normal_[s] = len > 0.0;
@@ -331,8 +350,23 @@ void Shells::compute() {
       Nr += wt * Sl.topLeftCorner<2, 2>();
       Mr += wt * zeta * Sl.topLeftCorner<2, 2>();
       Qr += wt * Sl.block<2, 1>(0, 2);
+      // Kelvin-Voigt viscosity (`dynamic_viscosity` eta; Holzapfel 2000, "Nonlinear Solid Mechanics",
+      // sect. 6.10: S = S_elastic + S_viscous): S_v = 2 eta E' on the in-plane components, E' = sym(F^T F')
+      // the Green-Lagrange strain rate with F' = [G' + zeta H' | d'] K from the velocities and the
+      // directors' spin. Through zeta it damps bending as well as stretching. The transverse shear is left
+      // undamped (its rate acts on the small rotary inertia rho t^3 / 12 and would bound the sub-step by
+      // ~t^2 rho / eta). A dissipation only: the forces below are the same contraction as the elastic
+      // ones, so their power is -sum V S_v : E' <= 0. Not in the energy, the resultants or the reported
+      // stress (those are the elastic tissue's; a steady load has E' = 0).
+      Mat3 St = Sl;
+      if (v_ && sp.eta > 0.0) {
+        const Mat3 Fd = columns(Gd_[s] + zeta * Hd_[s], omega_[s].cross(d_[s])) * K;
+        const Mat3 Ft = F.transpose() * Fd;
+        const Mat3 Ed = Q0.transpose() * (0.5 * (Ft + Ft.transpose())) * Q0;
+        St.topLeftCorner<2, 2>() += 2.0 * sp.eta * Ed.topLeftCorner<2, 2>();
+      }
       // dpsi/dF = F S (first Piola-Kirchhoff), dpsi/dJ = P K^T with J = [G + zeta H | d].
-      const Mat3 Pk = F * (Q0 * Sl * Q0.transpose());
+      const Mat3 Pk = F * (Q0 * St * Q0.transpose());
       const Mat3 dJ = V * Pk * K.transpose();
       PG += dJ.leftCols<2>();
       PH += zeta * dJ.leftCols<2>();
@@ -479,6 +513,10 @@ double Shells::stable_dt(double cfl, double max_speed) const {
         h *
         std::sqrt(1.0 / (c * c) / (2.0 + pi2 / 12.0 * (1.0 - p.nu) * (1.0 + 1.5 * (h / p.t) * (h / p.t))));
     dt = std::min(dt, cfl * std::min(h / (c + max_speed), rotary));
+    // Kelvin-Voigt viscosity: the explicit diffusion bound of Morris, Fox & Zhu 1997 (J. Comput. Phys.
+    // 136:214), dt <= 0.125 h^2 / nu, with the sheet's nu = 2 eta / rho (stretching and bending
+    // alike: both resist per mass as 2 eta / rho times a second difference of the velocity or spin).
+    if (p.eta > 0.0) dt = std::min(dt, 0.125 * h * h * p.rho0 / (2.0 * p.eta));
   }
   return dt;
 }

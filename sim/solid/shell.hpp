@@ -78,8 +78,10 @@ class Shells {
   void reindex(const Particles& P);
 
   // Resultants, energy, forces and director moments from the current positions and directors; adds the
-  // internal forces to f (indexed like P).
-  void update(const Particles& P);
+  // internal forces to f (indexed like P). v: the shells' velocities by slot, for a material with a
+  // `dynamic_viscosity` (its Kelvin-Voigt stress needs the strain rate; the directors' rate is omega x d);
+  // nullptr, or no viscous material: elastic forces only.
+  void update(const Particles& P, const std::vector<Vec3>* v = nullptr);
   // Checkpoint: the positions (by slot) and directors the last update() computed from, and that update
   // again from them (a resumed run then reads the same normals, stresses and forces before its first
   // update as the saved run did: they lag the positions by the last sub-step's drift).
@@ -238,6 +240,9 @@ class Shells {
   std::vector<double> energy_, vm_, strain_;
   std::vector<double> stiffening_;  // stiffening laws: the tangent's rise over its small-strain value (>= 1)
   bool stiffens_ = false;           // a material with a stiffening law (Lee-Sacks c1 > 0)
+  bool viscous_ = false;            // a material with a Kelvin-Voigt viscosity (eta > 0)
+  const std::vector<Vec3>* v_ = nullptr;  // the velocities of this update() (viscous_ only), by slot
+  std::vector<Mat32> Gd_, Hd_;            // their rates of G and H (viscous_ only)
   std::vector<Mat2> Nres_, Mres_;
   std::vector<Eigen::Vector2d> Qres_;
 };

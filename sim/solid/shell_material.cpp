@@ -16,6 +16,7 @@ ShellParams::ShellParams(const Material& m)
                            : m.youngs_modulus * m.poisson_ratio / (1.0 - m.poisson_ratio * m.poisson_ratio)),
       c_plate(std::sqrt(m.youngs_modulus / (m.density * (1.0 - nu * nu)))),
       damping(m.shell_damping),
+      eta(m.shell_viscosity),
       hourglass(m.hourglass),
       neo_hookean(m.neo_hookean),
       c1(m.lee_sacks_c1),

@@ -42,6 +42,7 @@ struct ShellParams {
   double kappa = 5.0 / 6.0;
   double c_plate = 0.0;  // plate (in-plane) wave speed sqrt(E / (rho0 (1 - nu^2))) [m/s]
   double damping = 0.0;  // [1/s]
+  double eta = 0.0;      // Kelvin-Voigt viscosity of the in-plane strain rate [Pa s] (Shells::compute)
   double hourglass = 0.0;
   bool neo_hookean = false;
   double c1 = 0.0, c2 = 0.0;     // Lee-Sacks exponential terms (c1 = 0: none)
