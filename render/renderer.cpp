@@ -504,7 +504,10 @@ struct Renderer::Impl {
       glUniform1f(glGetUniformLocation(splat_program, "u_ambient"), Lighting::kAmbient);
       glUniform1f(glGetUniformLocation(splat_program, "u_diffuse"), Lighting::kDiffuse);
       glUniform1f(glGetUniformLocation(splat_program, "u_specular"), Lighting::kSpecular);
-      glUniform1f(glGetUniformLocation(splat_program, "u_shininess"), Lighting::kShininess);
+      // splat.frag.glsl raises the specular term to the 24th power by squaring (no pow() per fragment).
+      static_assert(Lighting::kShininess == 24.0f, "splat.frag.glsl hard-codes the shininess 24");
+      const glm::vec3 half_vec = glm::normalize(glm::vec3(light[0], light[1], light[2] + 1.0f));
+      glUniform3fv(glGetUniformLocation(splat_program, "u_half_vec"), 1, glm::value_ptr(half_vec));
       glBindVertexArray(splat_vao);
       glBindBuffer(GL_ARRAY_BUFFER, splat_vbo);
       glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(splats.size() * sizeof(SplatVertex)),
