@@ -567,6 +567,8 @@ TEST_CASE("shell validation: a cantilever strip's energy over ten periods", "[.s
   cantilever_frequency_and_energy(10.0);
 }
 
+// [heavy]: 0.3 s in Release, 34 s under the sanitizers (whose shards skip [heavy]; the viscous code path is
+// covered there by "a rigid spin feels no Kelvin-Voigt force").
 // A clamped bar's first axial mode with and without the Kelvin-Voigt viscosity (`dynamic_viscosity`): with
 // nu = 0 the in-plane viscous stress 2 eta E' is the elastic E E times 2 eta / E, a stiffness-proportional
 // (Rayleigh) damping, so each in-plane mode decays at zeta = eta omega / E with its own omega.
@@ -604,7 +606,7 @@ static std::pair<double, double> bar_axial_mode(double eta, double periods) {
   return {omega, zeta};
 }
 
-TEST_CASE("shell viscosity: a bar's axial mode decays at zeta = eta omega / E", "[shell]") {
+TEST_CASE("shell viscosity: a bar's axial mode decays at zeta = eta omega / E", "[shell][heavy]") {
   const double E = 1e7, L = 0.2, omega0 = std::numbers::pi / 2 * std::sqrt(E / 1000.0) / L;
   const auto [w_el, z_el] = bar_axial_mode(0.0, 3.0);
   const double eta = 0.05 * E / omega0;
@@ -618,7 +620,7 @@ TEST_CASE("shell viscosity: a bar's axial mode decays at zeta = eta omega / E", 
 }
 
 TEST_CASE("shell viscosity: a strongly viscous plate shaken at every wavelength only loses energy",
-          "[shell]") {
+          "[shell][heavy]") {
   // A free square plate (no support) with random velocities on every particle: all its modes, the edge's
   // fastest included, at a viscosity that sets the sub-step (Shells::stable_dt): the total energy must fall
   // at every sample and end far below its start (an anti-dissipative or unstable viscous term fails).
