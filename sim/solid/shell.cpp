@@ -246,6 +246,7 @@ Shells::Shells(const Particles& P, const std::vector<Material>& materials, const
   if (viscous_) {
     Gd_.assign(n, Mat32::Zero());
     Hd_.assign(n, Mat32::Zero());
+    dd_.assign(n, Vec3::Zero());
   }
   G_.assign(n, Mat32::Zero());
   normal_.assign(n, Vec3::Zero());
@@ -295,6 +296,8 @@ void Shells::restore_update(std::vector<Vec3> x, std::vector<Vec3> d) {
 void Shells::compute() {
   const std::size_t n = X_.size();
   d_update_ = d_;
+  // The directors' rates d' = omega x d (the Kelvin-Voigt stress only), once per particle.
+  if (v_) parallel_for(n, [&](std::size_t s) { dd_[s] = omega_[s].cross(d_[s]); });
   // Mid-surface tangents and director gradient.
   parallel_for(n, [&](std::size_t s) {
     Mat32 G = Mat32::Zero(), H = Mat32::Zero();
@@ -309,11 +312,10 @@ void Shells::compute() {
     if (v_) {  // their rates (the Kelvin-Voigt stress): G' from the velocities, H' from d' = omega x d
       const std::vector<Vec3>& v = *v_;
       Mat32 Gd = Mat32::Zero(), Hd = Mat32::Zero();
-      const Vec3 dds = omega_[s].cross(d_[s]);
       for (uint32_t k = offset_[s]; k < offset_[s + 1]; ++k) {
         const uint32_t t = nbr_[k];
         Gd += area_[t] * (v[t] - v[s]) * g_[k].transpose();
-        Hd += area_[t] * (omega_[t].cross(d_[t]) - dds) * g_[k].transpose();
+        Hd += area_[t] * (dd_[t] - dd_[s]) * g_[k].transpose();
       }
       Gd_[s] = Gd;
       Hd_[s] = Hd;
@@ -384,7 +386,7 @@ void Shells::compute() {
       // stress (those are the elastic tissue's; a steady load has E' = 0).
       Mat3 St = Sl;
       if (v_ && sp.eta > 0.0) {
-        const Mat3 Fd = columns(Gd_[s] + zeta * Hd_[s], omega_[s].cross(d_[s])) * K;
+        const Mat3 Fd = columns(Gd_[s] + zeta * Hd_[s], dd_[s]) * K;
         const Mat3 Ft = F.transpose() * Fd;
         const Mat3 Ed = Q0.transpose() * (0.5 * (Ft + Ft.transpose())) * Q0;
         St.topLeftCorner<2, 2>() += 2.0 * sp.eta * Ed.topLeftCorner<2, 2>();
@@ -540,7 +542,7 @@ double Shells::stable_dt(double cfl, double max_speed) const {
     // Kelvin-Voigt viscosity: the damping's explicit (forward Euler) limit 2 / rate, the rate bounded by
     // (2 eta / rho) visc_lambda_ (the constructor's Gershgorin bound; bending resists per rotary inertia as
     // stretching per mass), times cfl.
-    if (p.eta > 0.0 && m < visc_lambda_.size() && visc_lambda_[m] > 0.0)
+    if (p.eta > 0.0 && visc_lambda_[m] > 0.0)  // sized to params_ whenever some eta > 0
       dt = std::min(dt, cfl * 2.0 / (2.0 * p.eta / p.rho0 * visc_lambda_[m]));
   }
   return dt;

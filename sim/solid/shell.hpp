@@ -243,6 +243,7 @@ class Shells {
   bool viscous_ = false;            // a material with a Kelvin-Voigt viscosity (eta > 0)
   const std::vector<Vec3>* v_ = nullptr;  // the velocities of this update() (viscous_ only), by slot
   std::vector<Mat32> Gd_, Hd_;            // their rates of G and H (viscous_ only)
+  std::vector<Vec3> dd_;                  // the directors' rates omega x d (viscous_ only)
   std::vector<double> visc_lambda_;       // per material: the viscous operator's rate bound [1/m^2]
   std::vector<Mat2> Nres_, Mres_;
   std::vector<Eigen::Vector2d> Qres_;
